@@ -1,0 +1,276 @@
+// mmrtm-render: renders a volume with the MM-RTM path tracer to a PNG.
+//
+//   mmrtm-render [INPUT] [--scene FILE.json] [--preset NAME] [--labels FILE] ...
+//
+// With no INPUT it renders the head CT of Debian's invesalius-examples
+// package with the ct-bone preset. Progress goes to stderr, the image to the
+// named file; the exit code is 0 only on success. See --help.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "cpu_renderer.h"
+#include "image_io.h"
+#include "mmrtmVolumeLoader.h"
+#include "scene_json.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const char* kUsage = R"(usage: mmrtm-render [INPUT] [options]
+
+Renders a volume with the MM-RTM volumetric path tracer.
+
+INPUT                   volume file (.nrrd/.nhdr, .nii/.nii.gz, .mha/.mhd, .vti, .vtk,
+                        .inv3) or a DICOM folder; the proxy named "scalars".
+                        Default: the head CT of Debian's invesalius-examples
+                        (%s)
+options:
+  --scene FILE.json     scene file (Documentation/scene-format.md); applied over the preset
+  --preset NAME         scene preset from %s
+                        (default: ct-bone when no --scene is given)
+  --labels FILE         label map, the proxy named "labels" (nearest lookup)
+  --width W             image width in pixels (default: scene, else 512)
+  --height H            image height in pixels (default: scene, else 512)
+  --spp N               samples per pixel (default: scene, else 64)
+  --seed S              random seed (default: scene, else 0)
+  --threads T           CPU threads, 0 for all (default: 0)
+  --estimator E         delta (unbiased, default) or raymarch (biased baseline)
+  --shadow-scale A      shadow-ray extinction scale in (0, 1] (default: 0.8; 1 is unbiased)
+  --max-bounces N       bounce limit (default: 32)
+  --exposure X          exposure multiplier before tone mapping (default: 1)
+  --output FILE.png     tone-mapped image (default: mmrtm-render.png)
+  --output-linear FILE.pfm   linear radiance, float RGB
+  --stats-json FILE     timings, samples, collisions, density lookups and noise
+  --quiet               no progress bar
+  --help                this text
+)";
+
+struct Options {
+  std::string input, scene, preset, labels, output = "mmrtm-render.png", outputLinear, statsJson;
+  json render = json::object();  // overrides of the scene's "render" block
+  bool quiet = false;
+};
+
+[[noreturn]] void UsageError(const std::string& msg) {
+  std::fprintf(stderr, "mmrtm-render: %s\n(see mmrtm-render --help)\n", msg.c_str());
+  std::exit(2);
+}
+
+std::string DataDirectory() {
+  if (const char* env = std::getenv("MMRTM_DATA_DIR")) return env;
+  return MMRTM_DATA_DIR;
+}
+
+long ParseInteger(const std::string& flag, const std::string& text, long lo, long hi) {
+  char* end = nullptr;
+  errno = 0;
+  long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end || errno || v < lo || v > hi)
+    UsageError(flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
+               text + "'");
+  return v;
+}
+
+double ParseReal(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end || !std::isfinite(v)) UsageError(flag + " expects a number, got '" + text + "'");
+  return v;
+}
+
+Options ParseArguments(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) UsageError(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::printf(kUsage, mmrtm::DefaultVolumePath().c_str(), (DataDirectory() + "/presets").c_str());
+      std::exit(0);
+    } else if (a == "--scene") o.scene = value();
+    else if (a == "--preset") o.preset = value();
+    else if (a == "--labels") o.labels = value();
+    else if (a == "--width") o.render["width"] = ParseInteger(a, value(), 1, 16384);
+    else if (a == "--height") o.render["height"] = ParseInteger(a, value(), 1, 16384);
+    else if (a == "--spp") o.render["spp"] = ParseInteger(a, value(), 1, 1 << 24);
+    else if (a == "--seed") o.render["seed"] = (uint64_t)ParseInteger(a, value(), 0, 0x7fffffffL);
+    else if (a == "--threads") o.render["threads"] = ParseInteger(a, value(), 0, 1024);
+    else if (a == "--max-bounces") o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);
+    else if (a == "--shadow-scale") o.render["shadow_extinction_scale"] = ParseReal(a, value());
+    else if (a == "--exposure") o.render["exposure"] = ParseReal(a, value());
+    else if (a == "--estimator") {
+      std::string e = value();
+      if (e != "delta" && e != "raymarch") UsageError("--estimator expects delta or raymarch, got '" + e + "'");
+      o.render["estimator"] = e;
+    } else if (a == "--output") o.output = value();
+    else if (a == "--output-linear") o.outputLinear = value();
+    else if (a == "--stats-json") o.statsJson = value();
+    else if (a == "--quiet") o.quiet = true;
+    else if (a.size() > 1 && a[0] == '-') UsageError("unknown option " + a);
+    else if (o.input.empty()) o.input = a;
+    else UsageError("more than one INPUT given ('" + o.input + "' and '" + a + "')");
+  }
+  return o;
+}
+
+// Fails early, before a long render, if an output cannot be written.
+void CheckWritable(const std::string& path) {
+  if (path.empty()) return;
+  fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent))
+    throw mmrtm::InputError(path + ": the folder " + parent.string() + " does not exist");
+  if (fs::is_directory(path)) throw mmrtm::InputError(path + ": is a folder");
+}
+
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
+  void operator()(int done, int total) {
+    if (!enabled_) return;
+    const double elapsed = Seconds();
+    const int percent = (int)(100.0 * done / total);
+    if (percent == lastPercent_ && done != total) return;
+    lastPercent_ = percent;
+    const int width = 30, filled = width * done / total;
+    const double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
+    std::fprintf(stderr, "\rRendering [%s%s] %3d%%  %.1f s, %.0f s left ", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), percent, elapsed, eta);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+  double Seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  bool enabled_;
+  std::chrono::steady_clock::time_point start_;
+  int lastPercent_ = -1;
+};
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+int Run(const Options& o) {
+  const auto tStart = std::chrono::steady_clock::now();
+  CheckWritable(o.output);
+  CheckWritable(o.outputLinear);
+  CheckWritable(o.statsJson);
+
+  // The scene document: preset, then the scene file over it, then the options.
+  json doc = json::object();
+  std::string baseDirectory = ".";
+  std::string preset = o.preset.empty() && o.scene.empty() ? "ct-bone" : o.preset;
+  if (!preset.empty()) doc = mmrtm::ReadJsonFile(mmrtm::PresetPath(DataDirectory() + "/presets", preset));
+  if (!o.scene.empty()) {
+    doc.merge_patch(mmrtm::ReadJsonFile(o.scene));
+    baseDirectory = fs::path(o.scene).parent_path().string();
+    if (baseDirectory.empty()) baseDirectory = ".";
+  }
+  if (!o.render.empty()) doc["render"].merge_patch(o.render);
+
+  mmrtm::SceneInputs inputs;
+  inputs.baseDirectory = baseDirectory;
+  inputs.loadVolume = [](const std::string& path, const std::string& name, mmrtm::Interpolation interp) {
+    return mmrtm::LoadVolume(path, name, interp);
+  };
+  const bool sceneHasScalars = doc.contains("volumes") && doc["volumes"].contains("scalars");
+  const std::string input = !o.input.empty() ? o.input : (sceneHasScalars ? "" : mmrtm::DefaultVolumePath());
+  if (!input.empty()) {
+    if (!o.quiet) std::fprintf(stderr, "Loading %s\n", input.c_str());
+    inputs.volumes["scalars"] = mmrtm::LoadVolume(input, "scalars");
+  }
+  if (!o.labels.empty()) {
+    if (!o.quiet) std::fprintf(stderr, "Loading labels %s\n", o.labels.c_str());
+    inputs.volumes["labels"] = mmrtm::LoadVolume(o.labels, "labels", mmrtm::Interpolation::Nearest);
+  }
+  const double loadSeconds = SecondsSince(tStart);
+
+  const auto tBuild = std::chrono::steady_clock::now();
+  mmrtm::Scene scene = mmrtm::SceneFromJson(doc, std::move(inputs));
+  mmrtm::SceneView view = scene.Build();
+  const double buildSeconds = SecondsSince(tBuild);
+
+  const mmrtm::RenderSettings& rs = scene.render;
+  mmrtm::CpuRenderer renderer(rs.threads);
+  mmrtm::Film film(rs.width, rs.height);
+  mmrtm::TraceCounters counters;
+  if (!o.quiet)
+    std::fprintf(stderr, "%d x %d, %d spp, %d thread(s), %s, majorant %.4g /mm\n", rs.width, rs.height,
+                 rs.samplesPerPixel, renderer.Threads(),
+                 rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
+                 view.majorants.globalMajorant);
+  ProgressBar bar(!o.quiet);
+  renderer.Render(view, film, rs.samplesPerPixel, &counters, [&](int d, int t) { bar(d, t); });
+  const double renderSeconds = bar.Seconds();
+
+  mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, film.ToneMapped(rs.exposure, rs.toneMapper));
+  if (!o.outputLinear.empty()) mmrtm::WritePFM(o.outputLinear, film.Linear());
+
+  const mmrtm::NoiseEstimate noise = film.Noise();
+  const double samples = (double)film.Width() * film.Height() * film.Samples();
+  if (!o.quiet)
+    std::fprintf(stderr, "Wrote %s: %.2f s render, %.3g samples/s, relative noise %.3g\n", o.output.c_str(),
+                 renderSeconds, samples / renderSeconds, noise.relative);
+  if (!o.statsJson.empty()) {
+    json stats = {
+        {"input", input},
+        {"width", film.Width()},
+        {"height", film.Height()},
+        {"spp", film.Samples()},
+        {"threads", renderer.Threads()},
+        {"seed", rs.integrator.seed},
+        {"estimator", rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "raymarch" : "delta"},
+        {"shadow_extinction_scale", rs.integrator.shadowExtinctionScale},
+        {"global_majorant", view.majorants.globalMajorant},
+        {"seconds", {{"load", loadSeconds}, {"build", buildSeconds}, {"render", renderSeconds},
+                     {"total", SecondsSince(tStart)}}},
+        {"samples", samples},
+        {"samples_per_second", samples / renderSeconds},
+        {"paths", counters.paths},
+        {"real_collisions", counters.realCollisions},
+        {"null_collisions", counters.nullCollisions},
+        {"density_lookups", counters.densityLookups},
+        {"shadow_rays", counters.shadowRays},
+        {"majorant_segments", counters.majorantSegments},
+        {"majorant_violations", counters.majorantViolations},
+        {"density_lookups_per_real_collision",
+         counters.realCollisions ? (double)counters.densityLookups / counters.realCollisions : 0.0},
+        {"noise", {{"mean_luminance", noise.meanLuminance}, {"rms_standard_error", noise.rmsStandardError},
+                   {"relative", noise.relative}}}};
+    const std::string tmp = o.statsJson + ".partial";
+    {
+      std::ofstream out(tmp);
+      out << stats.dump(2) << "\n";
+      if (!out) throw std::runtime_error(o.statsJson + ": write failed");
+    }
+    fs::rename(tmp, o.statsJson);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options = ParseArguments(argc, argv);
+  try {
+    return Run(options);
+  } catch (const mmrtm::InputError& e) {
+    std::fprintf(stderr, "\nmmrtm-render: error: %s\n", e.what());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "\nmmrtm-render: error: %s\n", e.what());
+  }
+  return 1;
+}

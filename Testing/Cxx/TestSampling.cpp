@@ -1,0 +1,223 @@
+// The BSDF, the phase function and the environment light: energy
+// conservation, and sampling that matches the pdf (chi-square test over a
+// grid of equal-area bins on the sphere).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "environment_map.h"
+#include "mmrtm/bsdf.h"
+#include "mmrtm/lights.h"
+#include "mmrtm/phase.h"
+#include "mmrtm/rng.h"
+
+namespace mmrtm {
+namespace {
+
+// Regularised upper incomplete gamma Q(a, x) (Numerical Recipes 6.2).
+double GammaQ(double a, double x) {
+  if (x <= 0) return 1.0;
+  const double gln = std::lgamma(a);
+  if (x < a + 1) {
+    double sum = 1.0 / a, del = sum, ap = a;
+    for (int n = 0; n < 1000; ++n) {
+      del *= x / ++ap;
+      sum += del;
+      if (std::fabs(del) < std::fabs(sum) * 1e-14) break;
+    }
+    return 1.0 - sum * std::exp(-x + a * std::log(x) - gln);
+  }
+  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
+  for (int i = 1; i < 1000; ++i) {
+    double an = -i * (i - a);
+    b += 2;
+    d = an * d + b;
+    if (std::fabs(d) < 1e-300) d = 1e-300;
+    c = b + an / c;
+    if (std::fabs(c) < 1e-300) c = 1e-300;
+    d = 1 / d;
+    double del = d * c;
+    h *= del;
+    if (std::fabs(del - 1) < 1e-14) break;
+  }
+  return std::exp(-x + a * std::log(x) - gln) * h;
+}
+
+Vec3 BinDirection(double cosTheta, double phi) {
+  double s = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
+  return {(float)(s * std::cos(phi)), (float)(s * std::sin(phi)), (float)cosTheta};
+}
+
+struct ChiSquareResult {
+  double pValue = 0;
+  double pdfIntegral = 0;  // integral of the pdf over the sphere
+  int validSamples = 0;
+};
+
+// Draws n samples (sample() returns false for "no sample"), bins them on a
+// grid uniform in cos(theta) and phi, compares with the pdf integrated over
+// each bin (sub x sub midpoint rule), pooling bins expecting fewer than 5.
+ChiSquareResult ChiSquare(const std::function<bool(PCG32&, Vec3*)>& sample, const std::function<double(Vec3)>& pdf,
+                          int n, int thetaBins = 20, int phiBins = 40, int sub = 8) {
+  const int bins = thetaBins * phiBins;
+  std::vector<double> observed(bins, 0), expected(bins, 0);
+  PCG32 rng(7, 11);
+  ChiSquareResult r;
+  for (int i = 0; i < n; ++i) {
+    Vec3 w;
+    if (!sample(rng, &w)) continue;
+    ++r.validSamples;
+    double phi = std::atan2(w.y, w.x);
+    if (phi < 0) phi += 2 * kPi;
+    int t = std::min(thetaBins - 1, (int)((1 - std::clamp((double)w.z, -1.0, 1.0)) * 0.5 * thetaBins));
+    int p = std::min(phiBins - 1, (int)(phi / (2 * kPi) * phiBins));
+    observed[t * phiBins + p] += 1;
+  }
+  const double binArea = 4 * kPi / bins;
+  for (int t = 0; t < thetaBins; ++t)
+    for (int p = 0; p < phiBins; ++p) {
+      double sum = 0;
+      for (int a = 0; a < sub; ++a)
+        for (int b = 0; b < sub; ++b) {
+          double cosTheta = 1 - 2.0 * (t + (a + 0.5) / sub) / thetaBins;
+          double phi = 2 * kPi * (p + (b + 0.5) / sub) / phiBins;
+          sum += pdf(BinDirection(cosTheta, phi));
+        }
+      expected[t * phiBins + p] = sum / (sub * sub) * binArea;
+      r.pdfIntegral += expected[t * phiBins + p];
+    }
+  double chi2 = 0, pooledO = 0, pooledE = 0;
+  int dof = -1;
+  for (int i = 0; i < bins; ++i) {
+    double e = expected[i] * n;
+    if (e < 5) {
+      pooledO += observed[i];
+      pooledE += e;
+      continue;
+    }
+    chi2 += (observed[i] - e) * (observed[i] - e) / e;
+    ++dof;
+  }
+  if (pooledE >= 5) {
+    chi2 += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
+    ++dof;
+  } else if (pooledO > 10) {
+    chi2 = 1e30;  // samples where the pdf says there are none
+  }
+  r.pValue = GammaQ(0.5 * std::max(dof, 1), 0.5 * chi2);
+  return r;
+}
+
+// Significance level of each chi-square test. The tests are deterministic
+// (fixed seed), so this only sets how large a real mismatch must be to fail.
+constexpr double kAlpha = 1e-3;
+
+TEST(Phase, HenyeyGreensteinIntegratesToOneAndSamplesItsPdf) {
+  const Vec3 wo = Normalize(Vec3{0.3f, -0.2f, 0.9f});
+  for (float g : {-0.7f, 0.f, 0.3f, 0.8f}) {
+    HGPhaseFunction phase{g};
+    ChiSquareResult r = ChiSquare(
+        [&](PCG32& rng, Vec3* w) {
+          float u0 = rng.Uniform(), u1 = rng.Uniform();
+          PhaseSample s = phase.Sample(wo, u0, u1);
+          EXPECT_NEAR(s.p, phase.p(wo, s.wi), 1e-3f * s.p);
+          *w = s.wi;
+          return true;
+        },
+        [&](Vec3 w) { return phase.Pdf(wo, w); }, 400000);
+    EXPECT_NEAR(r.pdfIntegral, 1.0, g > 0.5f ? 1e-2 : 2e-3) << "g " << g;
+    EXPECT_GT(r.pValue, kAlpha) << "g " << g;
+  }
+}
+
+TEST(BSDF, SamplingMatchesPdf) {
+  // The normal is +z so that the horizon, where the pdf drops to zero, is a
+  // bin edge: a tilted horizon cuts bins that the midpoint rule integrates badly.
+  const Vec3 normal{0.f, 0.f, 1.f};
+  for (float roughness : {0.35f, 0.7f, 1.f})
+    for (float metallic : {0.f, 1.f})
+      for (float cosO : {0.9f, 0.4f}) {
+        const float sinO = std::sqrt(1 - cosO * cosO);
+        const Vec3 wo{0.6f * sinO, 0.8f * sinO, cosO};
+        SurfaceBSDF bsdf = SurfaceBSDF::Make(normal, wo, RGB(0.8f, 0.6f, 0.4f), roughness, metallic);
+        ChiSquareResult r = ChiSquare(
+            [&](PCG32& rng, Vec3* w) {
+              float a = rng.Uniform(), b = rng.Uniform(), c = rng.Uniform();
+              BSDFSample s = bsdf.Sample(wo, a, b, c);
+              *w = s.wi;
+              return s.pdf > 0.f;
+            },
+            [&](Vec3 w) { return bsdf.Pdf(wo, w); }, 400000);
+        EXPECT_GT(r.pValue, kAlpha) << "roughness " << roughness << " metallic " << metallic << " cos " << cosO;
+        EXPECT_LE(r.pdfIntegral, 1.0 + 1e-2);
+      }
+}
+
+// Directional albedo: the integral of f cos over the hemisphere, estimated by
+// importance sampling; with a white base colour it must not exceed 1.
+TEST(BSDF, ConservesEnergy) {
+  const Vec3 normal{0.f, 0.f, 1.f};
+  const int n = 200000;
+  for (float roughness : {0.1f, 0.4f, 1.f})
+    for (float metallic : {0.f, 0.5f, 1.f})
+      for (float cosO : {1.f, 0.5f, 0.1f}) {
+        Vec3 wo{std::sqrt(1 - cosO * cosO), 0.f, cosO};
+        SurfaceBSDF bsdf = SurfaceBSDF::Make(normal, wo, RGB(1.f), roughness, metallic);
+        PCG32 rng(3, 5);
+        double sum = 0, sum2 = 0;
+        for (int i = 0; i < n; ++i) {
+          float a = rng.Uniform(), b = rng.Uniform(), c = rng.Uniform();
+          BSDFSample s = bsdf.Sample(wo, a, b, c);
+          double v = s.pdf > 0 ? s.f_cos.g / s.pdf : 0.0;
+          sum += v;
+          sum2 += v * v;
+        }
+        double mean = sum / n, sigma = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+        EXPECT_LE(mean, 1.0 + 3 * sigma) << "roughness " << roughness << " metallic " << metallic << " cos " << cosO;
+        // Not black: even a rough metal at grazing angles (single scattering
+        // loses the most there) keeps more than a fifth.
+        EXPECT_GT(mean, 0.2) << "roughness " << roughness << " metallic " << metallic << " cos " << cosO;
+      }
+}
+
+TEST(BSDF, BackSideLightIsAbsorbed) {
+  const Vec3 normal{0.f, 0.f, 1.f};
+  const Vec3 wo = Normalize(Vec3{0.3f, 0.f, 1.f});
+  SurfaceBSDF bsdf = SurfaceBSDF::Make(normal, wo, RGB(1.f), 0.5f, 0.f);
+  EXPECT_TRUE(bsdf.Eval(wo, Normalize(Vec3{0.2f, 0.1f, -1.f})).IsBlack());
+  EXPECT_EQ(bsdf.Pdf(wo, Normalize(Vec3{0.2f, 0.1f, -1.f})), 0.f);
+  EXPECT_FALSE(bsdf.Eval(wo, Normalize(Vec3{0.2f, 0.1f, 1.f})).IsBlack());
+  // Seen from the other side, the normal turns toward the viewer.
+  SurfaceBSDF flipped = SurfaceBSDF::Make(normal, -wo, RGB(1.f), 0.5f, 0.f);
+  EXPECT_FALSE(flipped.Eval(-wo, Normalize(Vec3{0.2f, 0.1f, -1.f})).IsBlack());
+}
+
+TEST(EnvironmentLight, SamplingMatchesPdf) {
+  // A sky with a small bright spot: the pdf must follow it.
+  const int w = 64, h = 32;
+  std::vector<RGB> texels((size_t)w * h, RGB(0.2f, 0.3f, 0.5f));
+  for (int y = 8; y < 11; ++y)
+    for (int x = 40; x < 44; ++x) texels[(size_t)y * w + x] = RGB(50.f, 40.f, 30.f);
+  for (auto env : {std::make_shared<EnvironmentMap>(w, h, texels), EnvironmentMap::DefaultSky(1.f)}) {
+    EnvironmentView view = env->View();
+    Light light;
+    light.type = LightType::Environment;
+    ChiSquareResult r = ChiSquare(
+        [&](PCG32& rng, Vec3* dir) {
+          float u0 = rng.Uniform(), u1 = rng.Uniform();
+          LightSample s = SampleLight(light, view, Vec3{}, u0, u1);
+          *dir = s.wi;
+          if (s.pdf > 0) EXPECT_NEAR(s.pdf, view.Pdf(s.wi), 1e-3f * s.pdf);
+          return s.pdf > 0.f;
+        },
+        // Texel edges do not line up with the bins: a finer midpoint rule.
+        [&](Vec3 d) { return view.Pdf(d); }, 400000, 32, 64, 32);
+    EXPECT_NEAR(r.pdfIntegral, 1.0, 2e-2);
+    EXPECT_GT(r.pValue, kAlpha);
+  }
+}
+
+}  // namespace
+}  // namespace mmrtm

@@ -1,0 +1,70 @@
+// Small synthetic scenes for the tracer's unit tests.
+#pragma once
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <vector>
+
+#include "scene.h"
+
+namespace mmrtm::test {
+
+// A float volume of dims n^3 ... with value f(i, j, k), unit spacing at the origin.
+inline HostVolume MakeVolume(int nx, int ny, int nz, const std::function<float(int, int, int)>& f,
+                             float spacing = 1.f, const char* name = "scalars") {
+  HostVolume v;
+  v.name = name;
+  v.source = name;
+  v.type = VoxelType::Float32;
+  v.dims = {nx, ny, nz};
+  v.voxels.resize((size_t)nx * ny * nz * sizeof(float));
+  float* p = reinterpret_cast<float*>(v.voxels.data());
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) p[i + (size_t)nx * (j + (size_t)ny * k)] = f(i, j, k);
+  v.indexToWorld = IndexToWorld({0, 0, 0}, {spacing, spacing, spacing}, {1, 0, 0, 0, 1, 0, 0, 0, 1});
+  return v;
+}
+
+inline HostVolume MakeConstantVolume(int n, float value, float spacing = 1.f) {
+  return MakeVolume(n, n, n, [value](int, int, int) { return value; }, spacing);
+}
+
+// A CCTF over proxy 0 mapping value v to v (identity), for density.
+inline TransferFunctionDesc IdentityCCTF(float lo, float hi, int proxy = 0) {
+  TransferFunctionDesc tf;
+  tf.where = "test";
+  tf.type = TFType::CCTF;
+  tf.proxy = proxy;
+  tf.channels = 1;
+  tf.keys = {lo, hi};
+  tf.values = {lo, hi};
+  return tf;
+}
+
+// One material whose sigma_t equals the voxel value of proxy 0 (times
+// `density`), with the given albedo; a constant environment; camera in front.
+inline Scene MakeMediumScene(HostVolume volume, float density, RGB albedo, float g = 0.f) {
+  Scene s;
+  auto range = volume.ValueRange();
+  s.proxies.push_back(std::move(volume));
+  s.tfs.push_back(IdentityCCTF(std::min(range[0], 0.f), std::max(range[1], 1.f)));
+  MaterialDesc m;
+  m.name = "medium";
+  m.base[0] = density;
+  m.base[1] = albedo.r;
+  m.base[2] = albedo.g;
+  m.base[3] = albedo.b;
+  m.base[10] = g;
+  m.bindings.push_back({0, Quantity::Density});
+  s.materials.push_back(m);
+  s.defaultMaterial = 0;
+  s.render.width = 16;
+  s.render.height = 16;
+  s.render.samplesPerPixel = 16;
+  s.render.integrator.shadowExtinctionScale = 1.f;
+  return s;
+}
+
+}  // namespace mmrtm::test

@@ -1,0 +1,61 @@
+#include "cpu_renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "mmrtm/integrator.h"
+
+namespace mmrtm {
+
+CpuRenderer::CpuRenderer(int threads)
+    : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())) {}
+
+void CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,
+                         const Progress& progress) const {
+  const int width = film.Width(), height = film.Height();
+  const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
+  const int tileCount = tilesX * tilesY;
+  const uint32_t firstSample = film.Samples();
+  FilmView view = film.View();
+  SceneView s = scene;
+  s.camera.width = width;
+  s.camera.height = height;
+
+  std::atomic<int> nextTile{0};
+  std::mutex progressMutex;
+  int tilesDone = 0;
+  std::vector<TraceCounters> perThread(threads_);
+
+  auto worker = [&](int thread) {
+    TraceCounters& ctr = perThread[thread];
+    for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
+      const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
+      const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x)
+          for (int i = 0; i < samplesPerPixel; ++i) {
+            const uint32_t index = firstSample + (uint32_t)i;
+            PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
+            view.AddSample(x, y, ps.L, ps.alpha, index + 1);
+          }
+      if (progress) {
+        std::lock_guard<std::mutex> lock(progressMutex);
+        progress(++tilesDone, tileCount);
+      }
+    }
+  };
+
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads_; ++t) pool.emplace_back(worker, t);
+  worker(0);
+  for (std::thread& t : pool) t.join();
+
+  film.AddSamples((uint32_t)samplesPerPixel);
+  if (counters)
+    for (const TraceCounters& c : perThread) *counters += c;
+}
+
+}  // namespace mmrtm

@@ -1,0 +1,35 @@
+// The CPU backend: a thread pool over image tiles running the shared
+// per-pixel integrator. Tiles are handed out dynamically, but each pixel's
+// samples depend only on (seed, pixel, sample index), so the image is the
+// same to the last bit at any thread count (DESIGN.md rule 2).
+#pragma once
+
+#include <functional>
+
+#include "film.h"
+#include "mmrtm/counters.h"
+#include "mmrtm/scene_view.h"
+
+namespace mmrtm {
+
+class CpuRenderer {
+ public:
+  // threads <= 0: one per hardware thread.
+  explicit CpuRenderer(int threads = 0);
+  int Threads() const { return threads_; }
+
+  // Called with (tiles done, tiles total) as tiles finish, from one thread at a time.
+  using Progress = std::function<void(int, int)>;
+
+  // Adds `samplesPerPixel` samples to every pixel of `film` (sample indices
+  // continue from film.Samples()) and adds the work done to `counters`.
+  void Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters = nullptr,
+              const Progress& progress = nullptr) const;
+
+  static constexpr int kTileSize = 16;
+
+ private:
+  int threads_;
+};
+
+}  // namespace mmrtm

@@ -1,0 +1,63 @@
+#include "film.h"
+
+#include <cmath>
+
+namespace mmrtm {
+
+Film::Film(int width, int height) : width_(width), height_(height) { Reset(); }
+
+void Film::Reset() {
+  samples_ = 0;
+  mean_.assign((size_t)width_ * height_ * 4, 0.f);
+  m2_.assign((size_t)width_ * height_ * 3, 0.f);
+}
+
+RGB Film::Mean(int x, int y) const {
+  const float* m = &mean_[4 * ((size_t)y * width_ + x)];
+  return RGB(m[0], m[1], m[2]);
+}
+
+RGB Film::VarianceOfMean(int x, int y) const {
+  if (samples_ < 2) return RGB(0.f);
+  const float* s = &m2_[3 * ((size_t)y * width_ + x)];
+  const float norm = 1.f / ((float)samples_ * (float)(samples_ - 1));
+  return RGB(s[0] * norm, s[1] * norm, s[2] * norm);
+}
+
+NoiseEstimate Film::Noise() const {
+  NoiseEstimate e;
+  double sumL = 0, sumVar = 0;
+  const double w[3] = {0.2126, 0.7152, 0.0722};
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      sumL += Luminance(Mean(x, y));
+      RGB v = VarianceOfMean(x, y);
+      // Luminance variance with the channels treated as independent (covariances ignored).
+      sumVar += w[0] * w[0] * v.r + w[1] * w[1] * v.g + w[2] * w[2] * v.b;
+    }
+  const double n = (double)width_ * height_;
+  e.meanLuminance = sumL / n;
+  e.rmsStandardError = std::sqrt(sumVar / n);
+  e.relative = e.meanLuminance > 0 ? e.rmsStandardError / e.meanLuminance : 0;
+  return e;
+}
+
+RGBImage Film::Linear() const {
+  RGBImage image{width_, height_, std::vector<RGB>((size_t)width_ * height_)};
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) image.pixels[(size_t)y * width_ + x] = Mean(x, y);
+  return image;
+}
+
+std::vector<uint8_t> Film::ToneMapped(float exposure, ToneMapper op, int channels) const {
+  std::vector<uint8_t> out((size_t)width_ * height_ * channels);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      uint8_t* p = &out[((size_t)y * width_ + x) * channels];
+      ToneMapPixel(Mean(x, y), exposure, op, p);
+      if (channels == 4) p[3] = (uint8_t)(Clamp(Alpha(x, y), 0.f, 1.f) * 255.f + 0.5f);
+    }
+  return out;
+}
+
+}  // namespace mmrtm

@@ -1,0 +1,47 @@
+// The host film: owns the accumulation buffers behind a FilmView, and turns
+// them into images and noise figures. Host-only.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "image_io.h"
+#include "mmrtm/film.h"
+#include "mmrtm/tonemap.h"
+
+namespace mmrtm {
+
+struct NoiseEstimate {
+  double meanLuminance = 0;     // over all pixels
+  double rmsStandardError = 0;  // root mean square over pixels of the standard error of the luminance mean
+  double relative = 0;          // rmsStandardError / meanLuminance
+};
+
+class Film {
+ public:
+  Film(int width, int height);
+
+  FilmView View() { return FilmView{width_, height_, mean_.data(), m2_.data()}; }
+  void Reset();
+  int Width() const { return width_; }
+  int Height() const { return height_; }
+  uint32_t Samples() const { return samples_; }
+  void AddSamples(uint32_t n) { samples_ += n; }
+
+  RGB Mean(int x, int y) const;
+  float Alpha(int x, int y) const { return mean_[4 * ((size_t)y * width_ + x) + 3]; }
+  // Variance of the pixel's mean estimate, per channel (0 before 2 samples).
+  RGB VarianceOfMean(int x, int y) const;
+  NoiseEstimate Noise() const;
+
+  RGBImage Linear() const;
+  // 8-bit sRGB, row 0 at the top; 4 channels adds alpha (premultiplied colour).
+  std::vector<uint8_t> ToneMapped(float exposure, ToneMapper op, int channels = 3) const;
+
+ private:
+  int width_, height_;
+  uint32_t samples_ = 0;
+  std::vector<float> mean_, m2_;
+};
+
+}  // namespace mmrtm

@@ -1,0 +1,95 @@
+#include "host_volume.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace mmrtm {
+
+VolumeView HostVolume::View() const {
+  VolumeView v;
+  v.data = voxels.data();
+  v.type = type;
+  v.interpolation = interpolation;
+  v.nx = dims[0];
+  v.ny = dims[1];
+  v.nz = dims[2];
+  try {
+    v.worldToIndex = AffineInverse(indexToWorld);
+  } catch (const std::runtime_error& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return v;
+}
+
+float HostVolume::Value(int64_t i) const {
+  switch (type) {
+    case VoxelType::UInt8: return (float)voxels[i];
+    case VoxelType::Int16: return (float)reinterpret_cast<const int16_t*>(voxels.data())[i];
+    case VoxelType::UInt16: return (float)reinterpret_cast<const uint16_t*>(voxels.data())[i];
+    default: return reinterpret_cast<const float*>(voxels.data())[i];
+  }
+}
+
+std::array<float, 2> HostVolume::ValueRange() const {
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (int64_t i = 0, n = VoxelCount(); i < n; ++i) {
+    float v = Value(i);
+    lo = v < lo ? v : lo;
+    hi = v > hi ? v : hi;
+  }
+  return {lo, hi};
+}
+
+std::array<Vec3, 2> HostVolume::WorldBounds() const {
+  Vec3 lo{kInfinity, kInfinity, kInfinity}, hi{-kInfinity, -kInfinity, -kInfinity};
+  for (int corner = 0; corner < 8; ++corner) {
+    Vec3 idx{(corner & 1) ? float(dims[0] - 1) : 0.f, (corner & 2) ? float(dims[1] - 1) : 0.f,
+             (corner & 4) ? float(dims[2] - 1) : 0.f};
+    Vec3 w = indexToWorld.ApplyPoint(idx);
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = Min(lo[a], w[a]);
+      hi[a] = Max(hi[a], w[a]);
+    }
+  }
+  return {lo, hi};
+}
+
+Vec3 HostVolume::WorldCenter() const {
+  return indexToWorld.ApplyPoint({0.5f * (dims[0] - 1), 0.5f * (dims[1] - 1), 0.5f * (dims[2] - 1)});
+}
+
+void HostVolume::Validate() const {
+  const std::string where = source.empty() ? name : source;
+  for (int a = 0; a < 3; ++a)
+    if (dims[a] <= 0) {
+      std::ostringstream msg;
+      msg << where << ": empty volume (dimensions " << dims[0] << " x " << dims[1] << " x " << dims[2] << ")";
+      throw InputError(msg.str());
+    }
+  if ((int64_t)voxels.size() != VoxelCount() * VoxelTypeSize(type))
+    throw InputError(where + ": voxel buffer size does not match the dimensions");
+  if (type == VoxelType::Float32) {
+    const float* f = reinterpret_cast<const float*>(voxels.data());
+    for (int64_t i = 0, n = VoxelCount(); i < n; ++i)
+      if (!std::isfinite(f[i])) {
+        std::ostringstream msg;
+        msg << where << ": non-finite voxel value (" << f[i] << ") at voxel " << i % dims[0] << ", "
+            << (i / dims[0]) % dims[1] << ", " << i / ((int64_t)dims[0] * dims[1]);
+        throw InputError(msg.str());
+      }
+  }
+  View();  // throws on singular geometry
+}
+
+Affine3 IndexToWorld(const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
+                     const std::array<double, 9>& d) {
+  Affine3 a;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) a.m[r][c] = (float)(d[3 * r + c] * spacing[c]);
+    a.m[r][3] = (float)origin[r];
+  }
+  return a;
+}
+
+}  // namespace mmrtm

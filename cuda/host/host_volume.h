@@ -1,0 +1,48 @@
+// A proxy volume owned on the host: native voxels plus world geometry.
+// Host-only set-up code; the tracer sees it through VolumeView.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mmrtm/volume.h"
+
+namespace mmrtm {
+
+// An error in the user's input (a file, a scene, an option). Its message names
+// the file or setting and the problem, and is meant to be shown as it is.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct HostVolume {
+  std::string name;    // the proxy name scenes refer to, e.g. "scalars"
+  std::string source;  // where it came from, for messages
+  VoxelType type = VoxelType::UInt8;
+  Interpolation interpolation = Interpolation::Trilinear;
+  std::array<int, 3> dims{0, 0, 0};
+  std::vector<uint8_t> voxels;  // dims[0]*dims[1]*dims[2] values of `type`, x fastest
+  Affine3 indexToWorld;         // voxel index -> world (millimetres, LPS for medical data)
+
+  int64_t VoxelCount() const { return (int64_t)dims[0] * dims[1] * dims[2]; }
+  VolumeView View() const;                      // throws if the geometry is singular
+  float Value(int64_t i) const;                 // voxel i converted to float
+  std::array<float, 2> ValueRange() const;      // min and max voxel value
+  std::array<Vec3, 2> WorldBounds() const;      // axis-aligned world box of the domain
+  Vec3 WorldCenter() const;
+
+  // Checks dims, buffer size and (for float voxels) finiteness; throws
+  // InputError naming `source` and the problem.
+  void Validate() const;
+};
+
+// index -> world from origin, spacing and a 3x3 direction matrix (columns are
+// the directions of the i, j, k axes), as in ITK and NRRD.
+Affine3 IndexToWorld(const std::array<double, 3>& origin, const std::array<double, 3>& spacing,
+                     const std::array<double, 9>& directionRowMajor);
+
+}  // namespace mmrtm

@@ -1,0 +1,113 @@
+// The host-side scene: owning storage for proxies, TFs, materials, lights,
+// camera and settings, and the flattening of all of it into the SceneView
+// that the backends trace. Host-only set-up code.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "environment_map.h"
+#include "host_volume.h"
+#include "mmrtm/scene_view.h"
+#include "mmrtm/tonemap.h"
+
+namespace mmrtm {
+
+struct TransferFunctionDesc {
+  std::string where;  // e.g. "materials[bone].density.tfs[0]", for messages
+  TFType type = TFType::CCTF;
+  int proxy = 0;
+  int channels = 1;
+  std::vector<float> keys;    // see TransferFunctionView for the layout
+  std::vector<float> values;  // coefficient TFs
+  std::vector<int> materials; // material TFs
+};
+
+struct MaterialDesc {
+  std::string name;
+  float base[kCoefficientFloats] = {
+      1.f,            // density
+      1.f, 1.f, 1.f,  // albedo
+      0.5f,           // roughness
+      0.f,            // metallic
+      0.f,            // surface probability
+      0.f, 0.f, 0.f,  // emission
+      0.f             // anisotropy g
+  };
+  struct Binding {
+    int tf;
+    Quantity quantity;
+  };
+  std::vector<Binding> bindings;  // tf indexes into Scene::tfs
+};
+
+struct CameraDesc {
+  Projection projection = Projection::Perspective;
+  // Auto framing (the default): look at the volume centre from the given
+  // azimuth and elevation (degrees) about the world z axis, starting from
+  // the anterior view (-y in LPS), at a distance that fits the volume.
+  bool autoFrame = true;
+  float azimuth = 0.f, elevation = 0.f, zoom = 1.f;
+  // Explicit placement (autoFrame false).
+  Vec3 position, lookAt, up{0.f, 0.f, 1.f};
+  float fovY = 30.f;         // degrees, perspective
+  float orthoHeight = 0.f;   // world units, orthographic; 0 fits the volume
+  float lensRadius = 0.f;    // world units; 0 is a pinhole
+  float focusDistance = 0.f; // world units; 0 focuses on the look-at point
+};
+
+struct RenderSettings {
+  int width = 512, height = 512;
+  int samplesPerPixel = 64;
+  int threads = 0;  // 0: all hardware threads
+  IntegratorSettings integrator;
+  float exposure = 1.f;
+  ToneMapper toneMapper = ToneMapper::Filmic;
+};
+
+class Scene {
+ public:
+  std::vector<HostVolume> proxies;  // proxy 0 is the original volume; it defines the tracked box
+  std::vector<TransferFunctionDesc> tfs;
+  std::vector<MaterialDesc> materials;
+  std::vector<int> selectors;  // material TFs (indexes into tfs), highest priority first
+  int defaultMaterial = kNoMaterial;
+  int gradientProxy = 0;
+  std::vector<Light> lights;  // directional and point lights
+  // Directional lights placed relative to the camera: from the direction
+  // toward the camera, turned `azimuth` degrees to the camera's right and
+  // `elevation` degrees up. Build() sets their direction.
+  struct CameraLight {
+    int light;
+    float azimuth, elevation;
+  };
+  std::vector<CameraLight> cameraLights;
+  std::shared_ptr<EnvironmentMap> environment;  // optional; null: no environment light
+  CameraDesc camera;
+  RenderSettings render;
+
+  int ProxyIndex(const std::string& name) const;  // -1 if absent
+  int MaterialIndex(const std::string& name) const;
+
+  // Validates everything and flattens it. The returned view points into this
+  // object's buffers: it stays valid until the next Build or destruction.
+  // Throws InputError naming the problem.
+  SceneView Build();
+
+  // sigma_t bound over the whole volume (the "none" accelerator's majorant).
+  float GlobalMajorant() const;
+
+ private:
+  void Validate() const;
+  CameraView BuildCamera() const;
+
+  std::vector<float> floatPool_;
+  std::vector<int> intPool_;
+  std::vector<TransferFunctionView> tfViews_;
+  std::vector<MaterialView> materialViews_;
+  std::vector<CoefficientBinding> bindings_;
+  std::vector<Light> lightViews_;
+};
+
+}  // namespace mmrtm

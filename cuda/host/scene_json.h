@@ -1,0 +1,41 @@
+// The JSON scene format (Documentation/scene-format.md): parsing into a
+// Scene, and the merging of presets. Host-only.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "scene.h"
+
+namespace mmrtm {
+
+// Loads the volume file `path` as the proxy `name`; supplied by the
+// application (the readers live outside cuda/).
+using VolumeLoader = std::function<HostVolume(const std::string& path, const std::string& name, Interpolation)>;
+
+struct SceneInputs {
+  VolumeLoader loadVolume;
+  // Volumes given outside the scene file (the command line's INPUT and
+  // --labels), by proxy name; they take the place of the scene's own files.
+  std::map<std::string, HostVolume> volumes;
+  // Folder that relative file names in the document are relative to.
+  std::string baseDirectory = ".";
+};
+
+// Reads a JSON document from a file; throws InputError naming the file and
+// the line of a syntax error.
+nlohmann::json ReadJsonFile(const std::string& path);
+
+// Builds a scene from a document. Every problem (unknown key, missing proxy,
+// TF without points, wrong type) throws InputError with the JSON path, e.g.
+// "materials.bone.tfs.density[0]: a transfer function needs at least one point".
+Scene SceneFromJson(const nlohmann::json& doc, SceneInputs inputs);
+
+// Path of preset `name` in the presets folder (Data/presets/NAME.json);
+// throws InputError listing the presets there if it does not exist.
+std::string PresetPath(const std::string& presetDirectory, const std::string& name);
+
+}  // namespace mmrtm

@@ -1,0 +1,112 @@
+// Classification of a point in three steps (paper section 5, DESIGN.md):
+//   1. sample every proxy (trilinear or nearest);
+//   2. pick the material: material TFs (MPCTF, MDPTF) in priority order; the
+//      first that names a material whose density is above zero there wins;
+//      otherwise the default material (if any) classifies the point;
+//   3. evaluate that material's coefficients, multiplying the coefficient
+//      TFs of each quantity across proxies.
+// Step 2 is the paper's rule "MDPTF wins where its opacity exceeds zero,
+// otherwise the CCTF of the original volume classifies".
+#pragma once
+
+#include "mmrtm/defs.h"
+#include "mmrtm/material.h"
+#include "mmrtm/transfer_function.h"
+#include "mmrtm/volume.h"
+
+namespace mmrtm {
+
+constexpr int kMaxProxies = 4;
+
+struct ProxySamples {
+  float v[kMaxProxies] = {};
+};
+
+struct Classification {
+  int material = kNoMaterial;
+  float sigma_t = 0.f;
+  ProxySamples proxies;
+};
+
+struct Classifier {
+  VolumeView proxies[kMaxProxies];
+  int proxyCount = 0;
+  const TransferFunctionView* tfs = nullptr;
+  const MaterialView* materials = nullptr;
+  const CoefficientBinding* bindings = nullptr;
+  const int* selectors = nullptr;  // material-TF indices into tfs, highest priority first
+  int selectorCount = 0;
+  int defaultMaterial = kNoMaterial;
+  int gradientProxy = 0;  // whose gradient gives the surface normal
+
+  MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world) const {
+    ProxySamples s;
+    for (int i = 0; i < proxyCount; ++i) s.v[i] = proxies[i].SampleWorld(world);
+    return s;
+  }
+
+  // Extinction of material m at the sampled proxy values.
+  MMRTM_CPU_GPU float Density(int m, const ProxySamples& s) const {
+    const MaterialView& mat = materials[m];
+    float d = mat.base[0];
+    for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
+      const TransferFunctionView& tf = tfs[bindings[mat.bindingBegin + b].tf];
+      float v;
+      tf.Evaluate(s.v[tf.proxy], &v);
+      d *= v;
+    }
+    return d;
+  }
+
+  MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
+    Classification c;
+    c.proxies = SampleProxies(world);
+    for (int i = 0; i < selectorCount; ++i) {
+      const TransferFunctionView& tf = tfs[selectors[i]];
+      int m = tf.EvaluateMaterial(c.proxies.v[tf.proxy]);
+      if (m == kNoMaterial) continue;
+      float d = Density(m, c.proxies);
+      if (d > 0.f) {
+        c.material = m;
+        c.sigma_t = d;
+        return c;
+      }
+    }
+    if (defaultMaterial != kNoMaterial) {
+      c.material = defaultMaterial;
+      c.sigma_t = Density(defaultMaterial, c.proxies);
+    }
+    return c;
+  }
+
+  // All coefficients of the classified material (at real collisions only).
+  MMRTM_CPU_GPU MaterialCoefficients Coefficients(const Classification& c) const {
+    MaterialCoefficients out;
+    if (c.material == kNoMaterial) return out;
+    const MaterialView& mat = materials[c.material];
+    float k[kCoefficientFloats];
+    for (int i = 0; i < kCoefficientFloats; ++i) k[i] = mat.base[i];
+    for (int b = mat.densityBindingCount; b < mat.bindingCount; ++b) {
+      const CoefficientBinding& bind = bindings[mat.bindingBegin + b];
+      const TransferFunctionView& tf = tfs[bind.tf];
+      float v[kMaxTFChannels];
+      tf.Evaluate(c.proxies.v[tf.proxy], v);
+      int offset = QuantityOffset(bind.quantity), n = QuantityChannels(bind.quantity);
+      for (int ch = 0; ch < n; ++ch) k[offset + ch] *= v[tf.channels == 1 ? 0 : ch];
+    }
+    out.sigma_t = c.sigma_t;
+    out.albedo = RGB(Clamp(k[1], 0.f, 1.f), Clamp(k[2], 0.f, 1.f), Clamp(k[3], 0.f, 1.f));
+    out.roughness = Clamp(k[4], 0.f, 1.f);
+    out.metallic = Clamp(k[5], 0.f, 1.f);
+    out.surfaceProbability = Clamp(k[6], 0.f, 1.f);
+    out.emission = RGB(k[7], k[8], k[9]);
+    out.g = Clamp(k[10], -0.99f, 0.99f);
+    return out;
+  }
+
+  // World-space gradient of the gradient proxy (by default the original
+  // volume): the surface normal of the MM-RTM (paper section 3).
+  MMRTM_CPU_GPU Vec3 Gradient(Vec3 world) const { return proxies[gradientProxy].GradientWorld(world); }
+};
+
+}  // namespace mmrtm

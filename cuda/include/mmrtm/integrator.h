@@ -1,0 +1,122 @@
+// The per-pixel MM-RTM path integrator (paper sections 3.1-3.2).
+//
+// A path is traced by free-path sampling. At each real collision:
+//   - the emission term sigma_t * Le is collected (DVR's opacity-weighted
+//     emission);
+//   - with probability P_fs the collision is a surface-scattering particle:
+//     the BSDF on the gradient normal, whose own albedo holds the surface
+//     absorption; otherwise a volume-scattering particle: the throughput is
+//     multiplied by the single-scattering albedo and the HG phase scatters;
+//   - next-event estimation samples one light and estimates the shadow ray's
+//     transmittance (ratio tracking, with the shadow extinction scale);
+//   - a new direction is sampled from the BSDF or phase function.
+// Environment light is combined by multiple importance sampling (power
+// heuristic) between light sampling and BSDF/phase sampling; delta lights are
+// reached by next-event estimation only. Russian roulette and a bounce limit
+// end long paths.
+#pragma once
+
+#include "mmrtm/bsdf.h"
+#include "mmrtm/phase.h"
+#include "mmrtm/tracking.h"
+
+namespace mmrtm {
+
+struct PixelSample {
+  RGB L;
+  float alpha = 0.f;  // 1 when the camera ray collided with the volume
+};
+
+MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, TraceCounters& ctr) {
+  PixelSample out;
+  RGB beta(1.f);
+  float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
+  float lightSelectPdf = s.lightCount > 0 ? 1.f / (float)s.lightCount : 0.f;
+  for (int depth = 0;; ++depth) {
+    FreePathResult fp = SampleFreePath(s, ray, kInfinity, rng, ctr);
+    if (!fp.collided) {
+      if (s.environmentLight >= 0) {
+        RGB Le = s.environment.Le(ray.d);
+        if (depth == 0) {
+          if (s.settings.backgroundVisible) out.L += beta * Le;
+        } else {
+          float w = PowerHeuristic(scatterPdf, lightSelectPdf * s.environment.Pdf(ray.d));
+          out.L += beta * Le * w;
+        }
+      }
+      break;
+    }
+    if (depth == 0) out.alpha = 1.f;
+
+    Vec3 p = ray(fp.t), wo = -ray.d;
+    MaterialCoefficients k = s.classifier.Coefficients(fp.c);
+    out.L += beta * k.emission;
+    if (depth >= s.settings.maxBounces) break;
+
+    // Which particle scattered: surface (BSDF) with probability P_fs.
+    bool surface = false;
+    SurfaceBSDF bsdf;
+    if (k.surfaceProbability > 0.f && rng.Uniform() < k.surfaceProbability) {
+      Vec3 G = s.classifier.Gradient(p);
+      float len = Length(G);
+      if (len > 0.f && isfinite(len)) {
+        surface = true;
+        bsdf = SurfaceBSDF::Make(G / len, wo, k.albedo, k.roughness, k.metallic);
+      }
+    }
+    HGPhaseFunction phase{k.g};
+    if (!surface) beta *= k.albedo;
+
+    // Next-event estimation with one light chosen uniformly.
+    if (s.lightCount > 0) {
+      int li = ClampInt((int)(rng.Uniform() * s.lightCount), 0, s.lightCount - 1);
+      float u0 = rng.Uniform(), u1 = rng.Uniform();
+      LightSample ls = SampleLight(s.lights[li], s.environment, p, u0, u1);
+      if (ls.pdf > 0.f && !ls.L.IsBlack()) {
+        RGB f = surface ? bsdf.Eval(wo, ls.wi) : RGB(phase.p(wo, ls.wi));
+        if (!f.IsBlack()) {
+          float T = Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr);
+          float lightPdf = lightSelectPdf * ls.pdf;
+          float w = ls.isDelta ? 1.f : PowerHeuristic(lightPdf, surface ? bsdf.Pdf(wo, ls.wi) : phase.Pdf(wo, ls.wi));
+          out.L += beta * f * ls.L * (T * w / lightPdf);
+        }
+      }
+    }
+
+    // Continue the path.
+    float uLobe = rng.Uniform(), u0 = rng.Uniform(), u1 = rng.Uniform();
+    Vec3 wi;
+    if (surface) {
+      BSDFSample bs = bsdf.Sample(wo, uLobe, u0, u1);
+      if (bs.pdf <= 0.f || bs.f_cos.IsBlack()) break;
+      beta *= bs.f_cos / bs.pdf;
+      wi = bs.wi;
+      scatterPdf = bs.pdf;
+    } else {
+      PhaseSample ps = phase.Sample(wo, u0, u1);
+      wi = ps.wi;  // p / pdf == 1 for HG
+      scatterPdf = ps.pdf;
+    }
+    ray = Ray{p, wi};
+
+    if (depth + 1 >= s.settings.russianRouletteDepth) {
+      float q = Max(0.f, 1.f - beta.MaxComponent());
+      if (rng.Uniform() < q) break;
+      beta = beta / (1.f - q);
+    }
+  }
+  return out;
+}
+
+// One sample of pixel (x, y): its own random stream (DESIGN.md rule 2), a
+// box-filtered position in the pixel, a lens position, and the path.
+MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, int y, uint32_t sampleIndex,
+                                                   TraceCounters& ctr) {
+  PCG32 rng = PixelSampleRNG(s.settings.seed, (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y, sampleIndex);
+  float fx = rng.Uniform(), fy = rng.Uniform(), l0 = rng.Uniform(), l1 = rng.Uniform();
+  Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
+  ++ctr.paths;
+  return Li(s, ray, rng, ctr);
+}
+
+}  // namespace mmrtm

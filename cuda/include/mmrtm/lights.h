@@ -1,0 +1,98 @@
+// Lights: directional, point, and an equirectangular environment map with
+// importance sampling over its texels (as pbrt-v4's ImageInfiniteLight, here
+// on a latitude-longitude parameterisation). World up is +z (superior in LPS), which is the
+// environment's zenith.
+#pragma once
+
+#include "mmrtm/defs.h"
+#include "mmrtm/sampling.h"
+#include "mmrtm/vecmath.h"
+
+namespace mmrtm {
+
+enum class LightType : uint8_t { Directional, Point, Environment };
+
+struct EnvironmentView {
+  const RGB* texels = nullptr;  // width*height, row 0 at the zenith
+  int width = 0, height = 0;
+  Distribution2DView distribution;  // over (u, v), proportional to luminance * sin(theta)
+
+  // (u, v) in [0,1)^2 for direction w: u from azimuth, v from polar angle.
+  MMRTM_CPU_GPU static void DirectionToUV(Vec3 w, float* u, float* v) {
+    float phi = atan2f(w.y, w.x);
+    if (phi < 0.f) phi += 2.f * kPi;
+    *u = Clamp(phi * kInv2Pi, 0.f, kOneMinusEpsilon);
+    *v = Clamp(acosf(Clamp(w.z, -1.f, 1.f)) * kInvPi, 0.f, kOneMinusEpsilon);
+  }
+  MMRTM_CPU_GPU static Vec3 UVToDirection(float u, float v) {
+    float phi = u * 2.f * kPi, theta = v * kPi;
+    float s = sinf(theta);
+    return {s * cosf(phi), s * sinf(phi), cosf(theta)};
+  }
+
+  MMRTM_CPU_GPU RGB Le(Vec3 w) const {
+    float u, v;
+    DirectionToUV(w, &u, &v);
+    int x = ClampInt((int)(u * width), 0, width - 1), y = ClampInt((int)(v * height), 0, height - 1);
+    return texels[x + width * y];
+  }
+  // Solid-angle pdf of sampling direction w.
+  MMRTM_CPU_GPU float Pdf(Vec3 w) const {
+    float u, v;
+    DirectionToUV(w, &u, &v);
+    float sinTheta = sinf(v * kPi);
+    if (sinTheta <= 0.f) return 0.f;
+    return distribution.Pdf(u, v) / (2.f * kPi * kPi * sinTheta);
+  }
+};
+
+struct Light {
+  LightType type = LightType::Directional;
+  Vec3 vector;  // directional: unit direction toward the light; point: position
+  RGB L;        // directional: irradiance at normal incidence; point: intensity
+};
+
+struct LightSample {
+  Vec3 wi;                // toward the light
+  float distance = kInfinity;
+  RGB L;                  // incident radiance (delta lights: irradiance)
+  float pdf = 0.f;        // solid-angle pdf; 1 for delta lights
+  bool isDelta = true;
+};
+
+MMRTM_CPU_GPU inline LightSample SampleLight(const Light& light, const EnvironmentView& env, Vec3 p, float u0,
+                                             float u1) {
+  LightSample s;
+  switch (light.type) {
+    case LightType::Directional:
+      s.wi = light.vector;
+      s.L = light.L;
+      s.pdf = 1.f;
+      break;
+    case LightType::Point: {
+      Vec3 d = light.vector - p;
+      float d2 = LengthSquared(d);
+      s.distance = sqrtf(d2);
+      s.wi = d / s.distance;
+      s.L = light.L / d2;
+      s.pdf = 1.f;
+      break;
+    }
+    case LightType::Environment: {
+      float u, v, pdfUV;
+      env.distribution.Sample(u0, u1, &u, &v, &pdfUV);
+      if (pdfUV <= 0.f) return s;  // pdf 0: no sample
+      s.wi = EnvironmentView::UVToDirection(u, v);
+      s.L = env.Le(s.wi);
+      // The pdf as Pdf(wi) computes it, so that the MIS weights of light and
+      // BSDF sampling use one function and sum to one (they could differ by
+      // a texel where the direction round trip crosses a texel edge).
+      s.pdf = env.Pdf(s.wi);
+      s.isDelta = false;
+      break;
+    }
+  }
+  return s;
+}
+
+}  // namespace mmrtm

@@ -1,0 +1,148 @@
+// The five unified transfer-function types of the paper (section 5).
+//
+// Coefficient TFs map a proxy value to a coefficient (1 or 3 channels):
+//   CCTF  curve: piecewise-linear between control points, clamped outside;
+//   CPCTF piecewise constant: value v_i on [lo_i, hi_i), zero elsewhere;
+//   CDPTF discrete points: value v_i where round(x) == key_i, zero elsewhere.
+// Material TFs map a proxy value to a material index (or kNoMaterial):
+//   MPCTF piecewise constant over [lo_i, hi_i) ranges;
+//   MDPTF discrete points (labels) where round(x) == key_i.
+// Overlapping ranges: the first listed range wins.
+//
+// Besides point evaluation each TF bounds itself over a value interval
+// (MaxOverRange): that is what makes majorants conservative for every TF
+// type (DESIGN.md rule 4), since a cell's trilinear interpolant takes every
+// value between its corner values and no other.
+#pragma once
+
+#include "mmrtm/defs.h"
+
+namespace mmrtm {
+
+enum class TFType : uint8_t { CCTF, CPCTF, CDPTF, MPCTF, MDPTF };
+constexpr int kNoMaterial = -1;
+constexpr int kMaxTFChannels = 3;
+
+MMRTM_CPU_GPU inline bool IsMaterialTF(TFType t) { return t == TFType::MPCTF || t == TFType::MDPTF; }
+MMRTM_CPU_GPU inline bool IsDiscreteTF(TFType t) { return t == TFType::CDPTF || t == TFType::MDPTF; }
+MMRTM_CPU_GPU inline bool IsRangeTF(TFType t) { return t == TFType::CPCTF || t == TFType::MPCTF; }
+
+// A view of one TF: flat arrays owned by the host scene.
+struct TransferFunctionView {
+  TFType type = TFType::CCTF;
+  uint8_t proxy = 0;     // which proxy volume it reads
+  uint8_t channels = 1;  // coefficient TFs: output channels (1 or 3)
+  int count = 0;         // control points, ranges or discrete entries
+  // CCTF, CDPTF, MDPTF: count keys, ascending.
+  // CPCTF, MPCTF: count [lo, hi) pairs, 2*count floats, in priority order.
+  const float* keys = nullptr;
+  const float* values = nullptr;    // coefficient TFs: count*channels
+  const int* materials = nullptr;   // material TFs: count material indices
+  // Discrete TFs: entry index by round(x) - denseMin, -1 for none, when the
+  // keys span a small integer range (labels); otherwise a binary search.
+  const int* denseIndex = nullptr;
+  int denseMin = 0, denseCount = 0;
+
+  // Entry index for x, or -1. For a CCTF: the segment start (see Evaluate).
+  MMRTM_CPU_GPU int FindEntry(float x) const {
+    if (IsDiscreteTF(type)) {
+      float r = floorf(x + 0.5f);
+      if (denseIndex) {
+        int i = (int)r - denseMin;
+        return (r >= (float)denseMin && i < denseCount) ? denseIndex[i] : -1;
+      }
+      int lo = 0, hi = count - 1;
+      while (lo <= hi) {
+        int mid = (lo + hi) >> 1;
+        if (keys[mid] == r) return mid;
+        if (keys[mid] < r) lo = mid + 1; else hi = mid - 1;
+      }
+      return -1;
+    }
+    // Ranges: first match in priority order.
+    for (int i = 0; i < count; ++i)
+      if (x >= keys[2 * i] && x < keys[2 * i + 1]) return i;
+    return -1;
+  }
+
+  // Coefficient TFs: writes `channels` values to out.
+  MMRTM_CPU_GPU void Evaluate(float x, float* out) const {
+    if (type == TFType::CCTF) {
+      if (x <= keys[0] || count == 1) return Copy(0, out);
+      if (x >= keys[count - 1]) return Copy(count - 1, out);
+      int lo = 0, hi = count - 1;  // keys[lo] < x < keys[hi]
+      while (hi - lo > 1) {
+        int mid = (lo + hi) >> 1;
+        if (keys[mid] <= x) lo = mid; else hi = mid;
+      }
+      float t = (x - keys[lo]) / (keys[hi] - keys[lo]);
+      for (int c = 0; c < channels; ++c)
+        out[c] = Lerp(t, values[lo * channels + c], values[hi * channels + c]);
+      return;
+    }
+    int i = FindEntry(x);
+    if (i < 0) {
+      for (int c = 0; c < channels; ++c) out[c] = 0.f;
+    } else {
+      Copy(i, out);
+    }
+  }
+
+  // Material TFs: the material at x, or kNoMaterial.
+  MMRTM_CPU_GPU int EvaluateMaterial(float x) const {
+    int i = FindEntry(x);
+    return i < 0 ? kNoMaterial : materials[i];
+  }
+
+  // Coefficient TFs: per-channel maximum over all x in [lo, hi].
+  MMRTM_CPU_GPU void MaxOverRange(float lo, float hi, float* out) const {
+    Evaluate(lo, out);
+    float tmp[kMaxTFChannels];
+    Evaluate(hi, tmp);
+    Accumulate(tmp, out);
+    for (int i = 0; i < count; ++i) {
+      if (EntryInRange(i, lo, hi)) Accumulate(values + i * channels, out);
+    }
+  }
+
+  // Material TFs: whether entry i (hence materials[i]) is reachable in [lo, hi].
+  MMRTM_CPU_GPU bool EntryInRange(int i, float lo, float hi) const {
+    if (IsRangeTF(type)) return keys[2 * i] <= hi && keys[2 * i + 1] > lo;
+    if (IsDiscreteTF(type)) return keys[i] >= floorf(lo + 0.5f) && keys[i] <= floorf(hi + 0.5f);
+    return keys[i] >= lo && keys[i] <= hi;
+  }
+
+  // Material TFs: whether some x in [lo, hi] maps to no material.
+  MMRTM_CPU_GPU bool MayMissInRange(float lo, float hi) const {
+    if (IsDiscreteTF(type)) {
+      // Missing unless every integer in [lo, hi] is a key.
+      for (float k = floorf(lo + 0.5f); k <= floorf(hi + 0.5f); k += 1.f)
+        if (FindEntry(k) < 0) return true;
+      return false;
+    }
+    // Ranges: covered if the union of ranges covers [lo, hi]; checked by
+    // walking the point forward through covering ranges.
+    float x = lo;
+    for (int pass = 0; pass < count; ++pass) {
+      bool advanced = false;
+      for (int i = 0; i < count; ++i)
+        if (x >= keys[2 * i] && x < keys[2 * i + 1]) {
+          x = keys[2 * i + 1];
+          advanced = true;
+        }
+      if (x > hi) return false;
+      if (!advanced) return true;
+    }
+    return x <= hi;
+  }
+
+ private:
+  MMRTM_CPU_GPU void Copy(int i, float* out) const {
+    for (int c = 0; c < channels; ++c) out[c] = values[i * channels + c];
+  }
+  MMRTM_CPU_GPU void Accumulate(const float* v, float* out) const {
+    for (int c = 0; c < channels; ++c) out[c] = Max(out[c], v[c]);
+  }
+};
+
+}  // namespace mmrtm

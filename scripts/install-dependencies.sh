@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs what the project needs on Debian 12, by package name.
+# Runs apt-get as root (directly, or through sudo when not root).
+set -euo pipefail
+packages=(
+  build-essential cmake git pkg-config
+  nlohmann-json3-dev libpng-dev zlib1g-dev libgtest-dev
+  libvtk9-dev python3-vtk9
+  xvfb xauth
+  invesalius-examples   # the default input: Cranium.inv3
+)
+as_root=()
+if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "Installing: ${missing[*]}" >&2
+  "${as_root[@]}" apt-get update -qq
+  "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
