@@ -15,6 +15,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "cpu_renderer.h"
 #include "image_io.h"
 #include "mmrtmVolumeLoader.h"
@@ -133,20 +135,24 @@ void CheckWritable(const std::string& path) {
   if (fs::is_directory(path)) throw mmrtm::InputError(path + ": is a folder");
 }
 
+// A bar redrawn in place on a terminal; on a log (not a terminal) one line
+// every 10 %.
 class ProgressBar {
  public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
+  explicit ProgressBar(bool enabled)
+      : enabled_(enabled), terminal_(isatty(fileno(stderr))), start_(std::chrono::steady_clock::now()) {}
   void operator()(int done, int total) {
     if (!enabled_) return;
     const double elapsed = Seconds();
     const int percent = (int)(100.0 * done / total);
-    if (percent == lastPercent_ && done != total) return;
+    const int step = terminal_ ? 1 : 10;
+    if (percent / step == lastPercent_ / step && done != total) return;
     lastPercent_ = percent;
     const int width = 30, filled = width * done / total;
     const double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
-    std::fprintf(stderr, "\rRendering [%s%s] %3d%%  %.1f s, %.0f s left ", std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(), percent, elapsed, eta);
-    if (done == total) std::fprintf(stderr, "\n");
+    std::fprintf(stderr, "%sRendering [%s%s] %3d%%  %.1f s, %.0f s left%s", terminal_ ? "\r" : "",
+                 std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), percent, elapsed, eta,
+                 terminal_ && done != total ? " " : "\n");
     std::fflush(stderr);
   }
   double Seconds() const {
@@ -154,7 +160,7 @@ class ProgressBar {
   }
 
  private:
-  bool enabled_;
+  bool enabled_, terminal_;
   std::chrono::steady_clock::time_point start_;
   int lastPercent_ = -1;
 };

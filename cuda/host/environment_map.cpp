@@ -79,7 +79,7 @@ std::shared_ptr<EnvironmentMap> EnvironmentMap::Constant(RGB radiance) {
 }
 
 std::shared_ptr<EnvironmentMap> EnvironmentMap::DefaultSky(float intensity) {
-  const int w = 64, h = 64;
+  const int w = 8, h = 256;  // constant along the azimuth; rows fine enough not to band
   const RGB zenith(0.50f, 0.66f, 1.00f), horizon(1.00f, 0.98f, 0.95f), ground(0.30f, 0.27f, 0.24f);
   std::vector<RGB> texels((size_t)w * h);
   for (int y = 0; y < h; ++y) {

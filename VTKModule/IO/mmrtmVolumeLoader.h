@@ -1,0 +1,42 @@
+// One volume loader for every application: reads a volume file or a DICOM
+// folder into a HostVolume (native voxels + index-to-world geometry).
+//
+// World space is LPS in millimetres (the DICOM/ITK convention). Voxels are
+// stored x fastest; HostVolume::indexToWorld maps voxel index (i, j, k) to
+// world. VTK is used behind this interface only: no VTK header here.
+#pragma once
+
+#include <string>
+
+#include "host_volume.h"
+
+namespace mmrtm {
+
+// Loads a volume file or a DICOM folder into a HostVolume named `name`.
+//
+// Formats, chosen by extension (case-insensitive):
+//   .nrrd .nhdr      NRRD (space directions / space origin honoured)
+//   .nii .nii.gz     NIfTI-1/2 (sform, else qform; RAS converted to LPS)
+//   .mha .mhd        MetaImage (TransformMatrix, Offset, ElementSpacing)
+//   .vti             VTK XML image data (origin, spacing, direction)
+//   .vtk             VTK legacy STRUCTURED_POINTS (origin, spacing)
+//   .inv3            InVesalius project (identity orientation, origin 0)
+//   a folder         DICOM series (uncompressed transfer syntaxes only)
+//
+// Voxel types: uint8, int16, uint16 and float32 are kept as they are. Other
+// types, and volumes with a rescale slope/intercept, become the smallest of
+// uint8 / int16 / uint16 that holds every value exactly when all values are
+// integers, else float32.
+//
+// Throws InputError, whose message names the file and the problem, for a
+// missing path, an unknown extension, an unreadable, corrupt or truncated
+// file, an empty volume, more than one component per voxel, non-finite
+// voxels and folders without readable DICOM files.
+HostVolume LoadVolume(const std::string& path, const std::string& name = "scalars",
+                      Interpolation interpolation = Interpolation::Trilinear);
+
+// The default input: InVesalius's Cranium.inv3 from Debian's
+// invesalius-examples package.
+std::string DefaultVolumePath();
+
+}  // namespace mmrtm
