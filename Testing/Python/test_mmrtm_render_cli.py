@@ -1,0 +1,149 @@
+"""mmrtm-render as a user runs it: good input renders, bad input gets a
+message naming the problem, a non-zero exit code and no output file.
+
+Run by ctest with MMRTM_RENDER (the binary) and MMRTM_SHARED_DATA_DIR set.
+"""
+import json
+import os
+import struct
+import subprocess
+import tempfile
+import unittest
+
+RENDER = os.environ["MMRTM_RENDER"]
+DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
+HEADSQ = os.path.join(DATA, "ct_head_headsq.nrrd")  # 64 x 64 x 93, small and fast
+
+
+class RenderCli(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+        self.png = os.path.join(self.dir, "out.png")
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def run_render(self, *args):
+        return subprocess.run([RENDER, *args, "--output", self.png, "--quiet"], capture_output=True, text=True,
+                              timeout=300)
+
+    def write(self, name, content, mode="w"):
+        path = os.path.join(self.dir, name)
+        with open(path, mode) as f:
+            f.write(content)
+        return path
+
+    def expect_failure(self, result, *fragments, code=1):
+        self.assertEqual(result.returncode, code, result.stderr)
+        for fragment in fragments:
+            self.assertIn(fragment, result.stderr)
+        self.assertFalse(os.path.exists(self.png), "a failed run must not leave an image")
+        self.assertEqual([f for f in os.listdir(self.dir) if f.startswith("out.")], [])
+
+    def test_renders_and_reports(self):
+        stats = os.path.join(self.dir, "stats.json")
+        pfm = os.path.join(self.dir, "out.pfm")
+        r = self.run_render(HEADSQ, "--width", "40", "--height", "30", "--spp", "4", "--seed", "3",
+                            "--stats-json", stats, "--output-linear", pfm)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(self.png, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        with open(stats) as f:
+            s = json.load(f)
+        self.assertEqual((s["width"], s["height"], s["spp"], s["seed"]), (40, 30, 4, 3))
+        self.assertEqual(s["paths"], 40 * 30 * 4)
+        self.assertGreater(s["density_lookups"], 0)
+        self.assertGreater(s["real_collisions"], 0)
+        self.assertEqual(s["majorant_violations"], 0)
+        self.assertGreater(s["noise"]["relative"], 0)
+        self.assertGreater(s["samples_per_second"], 0)
+        with open(pfm, "rb") as f:
+            header = f.readline() + f.readline() + f.readline()
+            self.assertEqual(header.split()[:3], [b"PF", b"40", b"30"])
+            pixels = struct.unpack("<%df" % (40 * 30 * 3), f.read())
+        self.assertGreater(max(pixels), 0.0)
+
+    def test_every_preset_renders(self):
+        cases = {
+            "ct-bone": [HEADSQ],
+            "ct-soft-tissue": [HEADSQ],
+            "ct-angio-labels": [os.path.join(DATA, "cta_chest_aorta.nii.gz"), "--labels",
+                                os.path.join(DATA, "cta_chest_aorta_labels.nii.gz")],
+            "mri": [os.path.join(DATA, "mr_head.nii.gz")],
+        }
+        presets = sorted(f[:-5] for f in os.listdir(os.path.join(os.path.dirname(__file__), "..", "..", "Data",
+                                                                 "presets")) if f.endswith(".json"))
+        self.assertEqual(presets, sorted(cases))
+        for preset, args in cases.items():
+            stats = os.path.join(self.dir, preset + ".json")
+            r = self.run_render(*args, "--preset", preset, "--width", "24", "--height", "24", "--spp", "2",
+                                "--stats-json", stats)
+            self.assertEqual(r.returncode, 0, preset + ": " + r.stderr)
+            with open(stats) as f:
+                self.assertGreater(json.load(f)["real_collisions"], 0, preset + " shows nothing")
+
+    def test_label_preset_without_labels(self):
+        self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-angio-labels"), "no proxy volume named 'labels'")
+
+    def test_missing_input(self):
+        self.expect_failure(self.run_render(os.path.join(self.dir, "nope.nrrd")), "nope.nrrd")
+
+    def test_unsupported_file_type(self):
+        path = self.write("volume.xyz", "not a volume")
+        self.expect_failure(self.run_render(path), "volume.xyz")
+
+    def test_non_finite_volume(self):
+        header = "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nendian: little\n\n"
+        values = struct.pack("<8f", 0, 1, 2, float("nan"), 4, 5, 6, 7)
+        path = self.write("nan.nrrd", header.encode() + values, "wb")
+        self.expect_failure(self.run_render(path), "nan.nrrd", "non-finite")
+
+    def test_truncated_volume(self):
+        with open(HEADSQ, "rb") as f:
+            data = f.read()
+        path = self.write("cut.nrrd", data[: len(data) // 2], "wb")
+        self.expect_failure(self.run_render(path), "cut.nrrd")
+
+    def test_scene_naming_a_missing_proxy(self):
+        scene = self.write("scene.json", json.dumps({
+            "materials": {"m": {"tfs": {"density": [{"type": "cctf", "proxy": "labels", "points": [[0, 1]]}]}}}}))
+        self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "no proxy volume named 'labels'")
+
+    def test_transfer_function_without_points(self):
+        scene = self.write("scene.json", json.dumps({
+            "materials": {"m": {"tfs": {"density": [{"type": "cctf", "points": []}]}}}}))
+        self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "materials.m.tfs.density[0]",
+                            "at least one point")
+
+    def test_unknown_scene_key(self):
+        scene = self.write("scene.json", json.dumps({"materials": {"m": {"albdeo": [1, 1, 1]}}}))
+        self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "unknown key 'albdeo'")
+
+    def test_invalid_json(self):
+        scene = self.write("scene.json", "{\"materials\": ")
+        self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "scene.json", "not valid JSON")
+
+    def test_unknown_preset(self):
+        self.expect_failure(self.run_render(HEADSQ, "--preset", "nope"), "no preset named 'nope'", "ct-bone")
+
+    def test_bad_option_value(self):
+        self.expect_failure(self.run_render(HEADSQ, "--spp", "many"), "--spp", code=2)
+        self.expect_failure(self.run_render(HEADSQ, "--frobnicate"), "unknown option", code=2)
+
+    def test_output_folder_missing(self):
+        r = subprocess.run([RENDER, HEADSQ, "--output", os.path.join(self.dir, "no", "out.png"), "--quiet"],
+                           capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("does not exist", r.stderr)
+
+    def test_help_lists_every_option(self):
+        r = subprocess.run([RENDER, "--help"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 0)
+        for option in ["--scene", "--preset", "--labels", "--width", "--height", "--spp", "--seed", "--threads",
+                       "--estimator", "--output", "--output-linear", "--stats-json"]:
+            self.assertIn(option, r.stdout)
+
+
+if __name__ == "__main__":
+    unittest.main()
