@@ -46,6 +46,11 @@ options:
   --seed S              random seed (default: scene, else 0)
   --threads T           CPU threads, 0 for all (default: 0)
   --estimator E         delta (unbiased, default) or raymarch (biased baseline)
+  --accelerator A       majorants for delta tracking: none (one global majorant),
+                        macrocell (uniform grid), octree (default: the hierarchical
+                        grid), octree-voxelmax (the paper's voxel-value refit; not
+                        conservative, for comparison only)
+  --leaf-level L        octree leaf level, -1 chooses from the volume size (default: -1)
   --shadow-scale A      shadow-ray extinction scale in (0, 1] (default: 0.8; 1 is unbiased)
   --max-bounces N       bounce limit (default: 32)
   --exposure X          exposure multiplier before tone mapping (default: 1)
@@ -115,7 +120,13 @@ Options ParseArguments(int argc, char** argv) {
       std::string e = value();
       if (e != "delta" && e != "raymarch") UsageError("--estimator expects delta or raymarch, got '" + e + "'");
       o.render["estimator"] = e;
-    } else if (a == "--output") o.output = value();
+    } else if (a == "--accelerator") {
+      std::string e = value();
+      if (e != "none" && e != "macrocell" && e != "octree" && e != "octree-voxelmax")
+        UsageError("--accelerator expects none, macrocell, octree or octree-voxelmax, got '" + e + "'");
+      o.render["accelerator"] = e;
+    } else if (a == "--leaf-level") o.render["leaf_level"] = ParseInteger(a, value(), -1, 11);
+    else if (a == "--output") o.output = value();
     else if (a == "--output-linear") o.outputLinear = value();
     else if (a == "--stats-json") o.statsJson = value();
     else if (a == "--quiet") o.quiet = true;

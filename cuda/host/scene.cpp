@@ -230,8 +230,29 @@ SceneView Scene::Build() {
   c.gradientProxy = gradientProxy;
   for (int a = 0; a < 3; ++a) s.domain[a] = proxies[0].dims[a];
 
-  s.majorants.kind = MajorantKind::Global;
+  c.tfCount = (int)tfViews_.size();
+  c.materialCount = (int)materialViews_.size();
+
+  // Majorants: the global bound always (it is cheap), the grid when asked
+  // for. The grid's summaries depend only on the voxels; a TF change refits.
+  const AcceleratorSettings& acc = render.accelerator;
+  s.majorants.kind = acc.kind;
   s.majorants.globalMajorant = GlobalMajorant();
+  if (acc.kind != MajorantKind::Global) {
+    const MajorantGridOptions& o = acc.grid;
+    const bool layoutChanged = grid_ && (grid_->Options().leafLevel != o.leafLevel ||
+                                         grid_->Options().margin != o.margin || grid_->Options().summary != o.summary);
+    if (!grid_ || dataModified_ || layoutChanged) {
+      if (!grid_) grid_ = std::make_unique<MajorantGrid>();
+      grid_->Build(proxies, o);
+    } else {
+      for (const auto& region : modifiedRegions_) grid_->UpdateRegion(proxies, region[0], region[1]);
+    }
+    grid_->Refit(c);
+    s.majorants.grid = grid_->View();
+  }
+  dataModified_ = false;
+  modifiedRegions_.clear();
 
   s.camera = BuildCamera();
   lightViews_ = lights;

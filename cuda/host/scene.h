@@ -9,6 +9,7 @@
 
 #include "environment_map.h"
 #include "host_volume.h"
+#include "majorant_grid.h"
 #include "mmrtm/scene_view.h"
 #include "mmrtm/tonemap.h"
 
@@ -57,11 +58,19 @@ struct CameraDesc {
   float focusDistance = 0.f; // world units; 0 focuses on the look-at point
 };
 
+// Which majorants the trackers use (MajorantKind), and how the grid is laid
+// out and summarised. "octree-voxelmax" is Octree with SummaryMode::VoxelValues.
+struct AcceleratorSettings {
+  MajorantKind kind = MajorantKind::Octree;
+  MajorantGridOptions grid;
+};
+
 struct RenderSettings {
   int width = 512, height = 512;
   int samplesPerPixel = 64;
   int threads = 0;  // 0: all hardware threads
   IntegratorSettings integrator;
+  AcceleratorSettings accelerator;
   float exposure = 1.f;
   ToneMapper toneMapper = ToneMapper::Filmic;
 };
@@ -98,6 +107,15 @@ class Scene {
   // sigma_t bound over the whole volume (the "none" accelerator's majorant).
   float GlobalMajorant() const;
 
+  // After the voxels of a proxy change: the next Build rebuilds the grid's
+  // summaries (a TF or material change only refits the majorants).
+  void MarkDataModified() { dataModified_ = true; }
+  // After the voxels in [lo, hi] (inclusive, proxy 0's index space) changed:
+  // the next Build rebuilds the summaries of the leaves there only.
+  void MarkRegionModified(std::array<int, 3> lo, std::array<int, 3> hi) { modifiedRegions_.push_back({lo, hi}); }
+  // The majorant grid of the last Build (null with the global majorant).
+  const MajorantGrid* Grid() const { return grid_.get(); }
+
  private:
   void Validate() const;
   CameraView BuildCamera() const;
@@ -108,6 +126,9 @@ class Scene {
   std::vector<MaterialView> materialViews_;
   std::vector<CoefficientBinding> bindings_;
   std::vector<Light> lightViews_;
+  std::unique_ptr<MajorantGrid> grid_;
+  bool dataModified_ = true;
+  std::vector<std::array<std::array<int, 3>, 2>> modifiedRegions_;
 };
 
 }  // namespace mmrtm

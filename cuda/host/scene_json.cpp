@@ -391,7 +391,8 @@ class Parser {
       const std::string w = "render";
       CheckKeys(rj, w,
                 {"width", "height", "spp", "seed", "threads", "estimator", "max_bounces", "russian_roulette_depth",
-                 "shadow_extinction_scale", "ray_march_step", "exposure", "tone_mapper", "background"});
+                 "shadow_extinction_scale", "ray_march_step", "exposure", "tone_mapper", "background", "accelerator",
+                 "leaf_level"});
       r.width = IntegerOr(rj, "width", r.width, w);
       r.height = IntegerOr(rj, "height", r.height, w);
       r.samplesPerPixel = IntegerOr(rj, "spp", r.samplesPerPixel, w);
@@ -409,6 +410,17 @@ class Parser {
           NumberOr(rj, "shadow_extinction_scale", r.integrator.shadowExtinctionScale, w);
       r.integrator.rayMarchStep = NumberOr(rj, "ray_march_step", r.integrator.rayMarchStep, w);
       r.integrator.backgroundVisible = BoolOr(rj, "background", r.integrator.backgroundVisible, w);
+      const std::string acc = StringOr(rj, "accelerator", "octree", w);
+      AcceleratorSettings& a = r.accelerator;
+      if (acc == "none") a.kind = MajorantKind::Global;
+      else if (acc == "macrocell") a.kind = MajorantKind::Macrocell;
+      else if (acc == "octree" || acc == "octree-voxelmax") a.kind = MajorantKind::Octree;
+      else Fail(w + ".accelerator", "expected none, macrocell, octree or octree-voxelmax, got '" + acc + "'");
+      a.grid.summary = acc == "octree-voxelmax" ? SummaryMode::VoxelValues : SummaryMode::CellRanges;
+      a.grid.leafLevel = IntegerOr(rj, "leaf_level", a.grid.leafLevel, w);
+      if (a.grid.leafLevel < -1 || a.grid.leafLevel >= kMaxGridLevels)
+        Fail(w + ".leaf_level", "expected -1 (automatic) to " + std::to_string(kMaxGridLevels - 1));
+      a.grid.threads = r.threads;
       r.exposure = NumberOr(rj, "exposure", r.exposure, w);
       const std::string tm = StringOr(rj, "tone_mapper", "filmic", w);
       if (tm != "filmic" && tm != "clamp") Fail(w + ".tone_mapper", "expected filmic or clamp");

@@ -32,7 +32,9 @@ struct Classifier {
   VolumeView proxies[kMaxProxies];
   int proxyCount = 0;
   const TransferFunctionView* tfs = nullptr;
+  int tfCount = 0;
   const MaterialView* materials = nullptr;
+  int materialCount = 0;
   const CoefficientBinding* bindings = nullptr;
   const int* selectors = nullptr;  // material-TF indices into tfs, highest priority first
   int selectorCount = 0;

@@ -1,12 +1,13 @@
 // Majorants as an iterator (pbrt-v4's RayMajorantIterator shape): the tracker
 // asks for segments {tMin, tMax, sigma_maj} along a ray, one after another,
-// and never knows who produced them. Here: the global majorant, one segment
-// over the whole volume (the baseline "none"). The grids of the accelerator
-// add kinds to MajorantSource and MajorantIterator without touching the
-// trackers.
+// and never knows who produced them:
+//   Global    one segment over the whole volume (the baseline "none");
+//   Macrocell a 3D-DDA over one uniform grid of majorants;
+//   Octree    the paper's multi-level traversal of the majorant grid.
 #pragma once
 
 #include "mmrtm/defs.h"
+#include "mmrtm/majorant_grid.h"
 #include "mmrtm/ray.h"
 
 namespace mmrtm {
@@ -15,40 +16,54 @@ struct RayMajorantSegment {
   float tMin = 0.f, tMax = 0.f, sigma_maj = 0.f;
 };
 
-enum class MajorantKind : uint8_t { Global };
+enum class MajorantKind : uint8_t { Global, Macrocell, Octree };
 
+// A tagged union of the two iterator shapes (no virtual calls on the GPU).
 class MajorantIterator {
  public:
   MajorantIterator() = default;
+
   MMRTM_CPU_GPU static MajorantIterator Single(float tMin, float tMax, float sigma_maj) {
     MajorantIterator it;
-    it.segment_ = {tMin, tMax, sigma_maj};
+    it.single_ = {tMin, tMax, sigma_maj};
     it.pending_ = tMin < tMax;
+    return it;
+  }
+  MMRTM_CPU_GPU static MajorantIterator Grid(const GridMajorantIterator& grid) {
+    MajorantIterator it;
+    it.grid_ = grid;
+    it.isGrid_ = true;
     return it;
   }
 
   MMRTM_CPU_GPU bool Next(RayMajorantSegment* seg) {
+    if (isGrid_) return grid_.Next(&seg->tMin, &seg->tMax, &seg->sigma_maj);
     if (!pending_) return false;
-    *seg = segment_;
+    *seg = single_;
     pending_ = false;
     return true;
   }
 
  private:
-  RayMajorantSegment segment_;
+  RayMajorantSegment single_;
+  GridMajorantIterator grid_;
   bool pending_ = false;
+  bool isGrid_ = false;
 };
 
 struct MajorantSource {
   MajorantKind kind = MajorantKind::Global;
   float globalMajorant = 0.f;  // bounds sigma_t everywhere in the volume
+  MajorantGridView grid;       // Macrocell and Octree
 
   // Segments over [tMin, tMax] of a ray given in the volume's index space
   // (its parameter t is the world distance). `scale` multiplies every
   // majorant (the shadow-ray extinction scale).
   MMRTM_CPU_GPU MajorantIterator Begin(const Ray& indexRay, float tMin, float tMax, float scale) const {
-    (void)indexRay;
-    return MajorantIterator::Single(tMin, tMax, globalMajorant * scale);
+    if (kind == MajorantKind::Global) return MajorantIterator::Single(tMin, tMax, globalMajorant * scale);
+    return MajorantIterator::Grid(GridMajorantIterator(
+        &grid, kind == MajorantKind::Macrocell ? GridTraversal::Macrocell : GridTraversal::Octree, indexRay, tMin,
+        tMax, scale));
   }
 };
 

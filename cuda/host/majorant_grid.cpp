@@ -1,0 +1,368 @@
+#include "majorant_grid.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+namespace mmrtm {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Runs fn(begin, end) over [0, n) in contiguous chunks on `threads` threads.
+template <typename Fn>
+void ParallelFor(int64_t n, int threads, Fn fn) {
+  if (threads <= 0) threads = (int)std::max(1u, std::thread::hardware_concurrency());
+  threads = (int)std::min<int64_t>(threads, std::max<int64_t>(n, 1));
+  if (threads <= 1) {
+    fn((int64_t)0, n);
+    return;
+  }
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(fn, n * t / threads, n * (t + 1) / threads);
+  for (std::thread& t : pool) t.join();
+}
+
+// Sets bins [b0, b1] of a kSummaryWords-word mask.
+inline void SetBinRange(uint64_t* words, int b0, int b1) {
+  for (int w = b0 >> 6; w <= (b1 >> 6); ++w) {
+    const int lo = std::max(b0 - (w << 6), 0), hi = std::min(b1 - (w << 6), 63);
+    const uint64_t upper = hi == 63 ? ~0ull : ((1ull << (hi + 1)) - 1);
+    words[w] |= upper & ~((1ull << lo) - 1);
+  }
+}
+
+// Calls fn(bin) for every set bin of a mask.
+template <typename Fn>
+inline void ForEachBin(const uint64_t* words, Fn fn) {
+  for (int w = 0; w < kSummaryWords; ++w)
+    for (uint64_t bits = words[w]; bits; bits &= bits - 1) fn((w << 6) + __builtin_ctzll(bits));
+}
+
+// The bins of a voxel block [lo, hi] (inclusive) of one proxy: each voxel's
+// bin, and with `edges` every bin between the bins of neighbouring voxels
+// (the range a trilinear cell takes is the union of its edge intervals, and
+// the bin of the min and max of an edge are the min and max of its bins).
+template <typename T>
+void SummarizeBlock(const T* data, const std::array<int, 3>& dims, const int lo[3], const int hi[3],
+                    const MajorantGrid::BinMap& bins, bool edges, uint64_t* words, std::vector<int16_t>& scratch) {
+  const int nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1, nz = hi[2] - lo[2] + 1;
+  scratch.resize((size_t)nx * ny * nz);
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y) {
+      const T* row = data + lo[0] + (int64_t)dims[0] * ((y + lo[1]) + (int64_t)dims[1] * (z + lo[2]));
+      int16_t* out = &scratch[(size_t)nx * (y + (size_t)ny * z)];
+      for (int x = 0; x < nx; ++x) out[x] = (int16_t)bins.Bin((float)row[x]);
+    }
+  auto at = [&](int x, int y, int z) { return scratch[x + (size_t)nx * (y + (size_t)ny * z)]; };
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        const int b = at(x, y, z);
+        int b0 = b, b1 = b;
+        if (edges) {
+          if (x + 1 < nx) b0 = std::min(b0, (int)at(x + 1, y, z)), b1 = std::max(b1, (int)at(x + 1, y, z));
+          if (y + 1 < ny) b0 = std::min(b0, (int)at(x, y + 1, z)), b1 = std::max(b1, (int)at(x, y + 1, z));
+          if (z + 1 < nz) b0 = std::min(b0, (int)at(x, y, z + 1)), b1 = std::max(b1, (int)at(x, y, z + 1));
+        }
+        if (b0 == b1) {
+          words[b0 >> 6] |= 1ull << (b0 & 63);
+        } else {
+          SetBinRange(words, b0, b1);
+        }
+      }
+}
+
+}  // namespace
+
+int MajorantGrid::BinMap::Bin(float v) const {
+  const int b = (int)std::floor((v - lo) / width);
+  return std::clamp(b, 0, kSummaryBins - 1);
+}
+
+void MajorantGrid::BinMap::Range(int bin, float* rangeLo, float* rangeHi) const {
+  if (discrete) {
+    // Label value lo + bin; TFs round to the nearest integer.
+    *rangeLo = lo + bin - 0.25f;
+    *rangeHi = lo + bin + 0.25f;
+  } else {
+    // Slack for the rounding of Bin(); the last bin also holds everything above.
+    const float slack = 1e-3f * width;
+    *rangeLo = lo + bin * width - slack;
+    *rangeHi = bin == kSummaryBins - 1 ? kInfinity : lo + (bin + 1) * width + slack;
+    if (bin == 0) *rangeLo = -kInfinity;
+  }
+}
+
+int64_t MajorantGrid::LeafCount() const {
+  const int L = view_.leafLevel;
+  return (int64_t)view_.res[L][0] * view_.res[L][1] * view_.res[L][2];
+}
+
+void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantGridOptions& options) {
+  const auto start = Clock::now();
+  options_ = options;
+  proxyCount_ = (int)proxies.size();
+  const HostVolume& v0 = proxies.at(0);
+
+  // Levels: leaves of leafSize cells, each level above twice as wide.
+  view_ = MajorantGridView{};
+  int maxCells = 1;
+  for (int a = 0; a < 3; ++a) {
+    view_.cells[a] = std::max(v0.dims[a] - 1, 1);
+    maxCells = std::max(maxCells, view_.cells[a]);
+  }
+  int leafLevel = options.leafLevel;
+  if (leafLevel < 0) leafLevel = (int)std::ceil(std::log2(std::max(1.0, (double)maxCells / kTargetLeafCells)));
+  leafLevel = std::clamp(leafLevel, 0, kMaxGridLevels - 1);
+  view_.leafLevel = leafLevel;
+  const int leafSize = std::max(1, (int)std::ceil((double)maxCells / (double)(1 << leafLevel)));
+  float maxSpacing = 0.f;
+  for (int a = 0; a < 3; ++a)
+    maxSpacing = std::max(maxSpacing, Length(Vec3{v0.indexToWorld.m[0][a], v0.indexToWorld.m[1][a],
+                                                  v0.indexToWorld.m[2][a]}));
+  int64_t offset = 0;
+  for (int l = 0; l <= leafLevel; ++l) {
+    view_.nodeSize[l] = leafSize << (leafLevel - l);
+    for (int a = 0; a < 3; ++a) view_.res[l][a] = (view_.cells[a] + view_.nodeSize[l] - 1) / view_.nodeSize[l];
+    view_.offset[l] = offset;
+    view_.worldWidth[l] = view_.nodeSize[l] * maxSpacing;
+    offset += (int64_t)view_.res[l][0] * view_.res[l][1] * view_.res[l][2];
+  }
+  majorants_.assign(offset, 0.f);
+  view_.majorants = majorants_.data();
+
+  // Value bins per proxy, and the map from proxy 0's index space to each proxy's.
+  for (int k = 0; k < proxyCount_; ++k) {
+    const HostVolume& v = proxies[k];
+    const auto range = v.ValueRange();
+    BinMap& b = bins_[k];
+    b.lo = range[0];
+    bool integral = v.type != VoxelType::Float32;
+    if (!integral) {
+      integral = true;
+      for (int64_t i = 0, n = v.VoxelCount(); i < n && integral; ++i) integral = v.Value(i) == std::floor(v.Value(i));
+    }
+    b.discrete = v.interpolation == Interpolation::Nearest && integral && range[1] - range[0] < kSummaryBins;
+    b.width = b.discrete ? 1.f : std::max((range[1] - range[0]) / kSummaryBins, 1e-30f);
+    if (!(range[1] > range[0])) b.width = 1.f;
+    if (options_.summary == SummaryMode::VoxelValues) continue;
+    leafIndexToProxy_[k] = AffineCompose(v.View().worldToIndex, v0.indexToWorld);
+    sameGrid_[k] = AffineIsIdentity(leafIndexToProxy_[k], 1e-5f) && v.dims == v0.dims;
+    summaries_[k].assign((size_t)LeafCount() * kSummaryWords, 0);
+  }
+  // The voxel-value refit reads the voxels themselves: no summaries.
+  if (options_.summary == SummaryMode::CellRanges) {
+    const int L = view_.leafLevel;
+    const int lo[3] = {0, 0, 0}, hi[3] = {view_.res[L][0] - 1, view_.res[L][1] - 1, view_.res[L][2] - 1};
+    ParallelFor(view_.res[L][2], options_.threads,
+                [&](int64_t z0, int64_t z1) { BuildLeaves(proxies, (int)z0, (int)z1, lo, hi); });
+  }
+  buildSeconds_ = SecondsSince(start);
+}
+
+void MajorantGrid::UpdateRegion(const std::vector<HostVolume>& proxies, std::array<int, 3> lo, std::array<int, 3> hi) {
+  if (options_.summary == SummaryMode::VoxelValues) return;  // its refit reads the voxels
+  const auto start = Clock::now();
+  const int L = view_.leafLevel, size = view_.nodeSize[L], m = options_.margin;
+  int leafLo[3], leafHi[3];
+  for (int a = 0; a < 3; ++a) {
+    // A voxel touches the cells on both sides of it, plus the margins.
+    leafLo[a] = std::clamp((lo[a] - 1 - m) / size, 0, view_.res[L][a] - 1);
+    leafHi[a] = std::clamp((hi[a] + m) / size, 0, view_.res[L][a] - 1);
+  }
+  for (int k = 0; k < proxyCount_; ++k)
+    for (int z = leafLo[2]; z <= leafHi[2]; ++z)
+      for (int y = leafLo[1]; y <= leafHi[1]; ++y)
+        for (int x = leafLo[0]; x <= leafHi[0]; ++x) {
+          uint64_t* w = &summaries_[k][(size_t)(x + (int64_t)view_.res[L][0] * (y + (int64_t)view_.res[L][1] * z)) *
+                                       kSummaryWords];
+          std::fill(w, w + kSummaryWords, 0ull);
+        }
+  ParallelFor(leafHi[2] - leafLo[2] + 1, options_.threads, [&](int64_t z0, int64_t z1) {
+    BuildLeaves(proxies, leafLo[2] + (int)z0, leafLo[2] + (int)z1, leafLo, leafHi);
+  });
+  buildSeconds_ = SecondsSince(start);
+}
+
+void MajorantGrid::BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3],
+                               const int hi[3]) {
+  for (int z = z0; z < z1; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x) SummarizeLeaf(proxies, x, y, z);
+}
+
+void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz) {
+  thread_local std::vector<int16_t> scratch;
+  const int L = view_.leafLevel, size = view_.nodeSize[L], m = options_.margin;
+  const int leaf[3] = {lx, ly, lz};
+  // The leaf's cells with the margin, in proxy 0's index space.
+  float boxLo[3], boxHi[3];
+  for (int a = 0; a < 3; ++a) {
+    boxLo[a] = (float)std::max(0, leaf[a] * size - m);
+    boxHi[a] = (float)std::min(view_.cells[a], (leaf[a] + 1) * size + m);
+  }
+  const int64_t leafIndex = lx + (int64_t)view_.res[L][0] * (ly + (int64_t)view_.res[L][1] * lz);
+  for (int k = 0; k < proxyCount_; ++k) {
+    const HostVolume& v = proxies[k];
+    // The voxels whose values points of the box can see in proxy k: the
+    // bounding box of the box's corners, widened to whole voxels.
+    int lo[3], hi[3];
+    float pLo[3] = {kInfinity, kInfinity, kInfinity}, pHi[3] = {-kInfinity, -kInfinity, -kInfinity};
+    for (int c = 0; c < 8; ++c) {
+      Vec3 p = leafIndexToProxy_[k].ApplyPoint(
+          {(c & 1) ? boxHi[0] : boxLo[0], (c & 2) ? boxHi[1] : boxLo[1], (c & 4) ? boxHi[2] : boxLo[2]});
+      for (int a = 0; a < 3; ++a) {
+        pLo[a] = std::min(pLo[a], p[a]);
+        pHi[a] = std::max(pHi[a], p[a]);
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      // Exact integers for a proxy on proxy 0's grid; otherwise every voxel
+      // that a trilinear or nearest lookup in the box can reach.
+      lo[a] = std::clamp((int)std::floor(pLo[a] + 1e-4f), 0, v.dims[a] - 1);
+      hi[a] = std::clamp((int)std::ceil(pHi[a] - 1e-4f), 0, v.dims[a] - 1);
+      if (!sameGrid_[k]) {
+        lo[a] = std::clamp((int)std::floor(pLo[a]) - 1, 0, v.dims[a] - 1);
+        hi[a] = std::clamp((int)std::ceil(pHi[a]) + 1, 0, v.dims[a] - 1);
+      }
+    }
+    const bool edges = v.interpolation == Interpolation::Trilinear && options_.summary == SummaryMode::CellRanges;
+    uint64_t* words = &summaries_[k][(size_t)leafIndex * kSummaryWords];
+    switch (v.type) {
+      case VoxelType::UInt8:
+        SummarizeBlock(v.voxels.data(), v.dims, lo, hi, bins_[k], edges, words, scratch);
+        break;
+      case VoxelType::Int16:
+        SummarizeBlock(reinterpret_cast<const int16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], edges, words,
+                       scratch);
+        break;
+      case VoxelType::UInt16:
+        SummarizeBlock(reinterpret_cast<const uint16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], edges, words,
+                       scratch);
+        break;
+      case VoxelType::Float32:
+        SummarizeBlock(reinterpret_cast<const float*>(v.voxels.data()), v.dims, lo, hi, bins_[k], edges, words,
+                       scratch);
+        break;
+    }
+  }
+}
+
+void MajorantGrid::RefitFromVoxelValues(const Classifier& c) {
+  // The paper's refit: each leaf visits its voxels and takes the largest
+  // extinction the classification gives at them. Its cost grows with the
+  // voxel count, and a TF peak between two voxel values is missed.
+  const int L = view_.leafLevel, size = view_.nodeSize[L];
+  const VolumeView& v0 = c.proxies[0];
+  const Affine3 indexToWorld = AffineInverse(v0.worldToIndex);
+  const int* res = view_.res[L];
+  ParallelFor(LeafCount(), options_.threads, [&](int64_t begin, int64_t end) {
+    for (int64_t leaf = begin; leaf < end; ++leaf) {
+      const int cell[3] = {(int)(leaf % res[0]), (int)((leaf / res[0]) % res[1]), (int)(leaf / ((int64_t)res[0] * res[1]))};
+      int lo[3], hi[3];
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = cell[a] * size;
+        hi[a] = std::min((cell[a] + 1) * size, (&v0.nx)[a] - 1);
+      }
+      float majorant = 0.f;
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+          for (int x = lo[0]; x <= hi[0]; ++x)
+            majorant = std::max(majorant, c.Classify(indexToWorld.ApplyPoint({(float)x, (float)y, (float)z})).sigma_t);
+      majorants_[view_.offset[L] + leaf] = majorant;
+    }
+  });
+}
+
+void MajorantGrid::Refit(const Classifier& c) {
+  const auto start = Clock::now();
+  if (options_.summary == SummaryMode::VoxelValues) {
+    RefitFromVoxelValues(c);
+    RefitUpperLevels();
+    refitSeconds_ = SecondsSince(start);
+    return;
+  }
+  // Per TF and bin: the TF's maximum (coefficient TFs) or the materials it
+  // can pick (material TFs) over the bin's value range.
+  std::vector<float> binMax((size_t)c.tfCount * kSummaryBins, 0.f);
+  std::vector<uint64_t> binMaterials((size_t)c.tfCount * kSummaryBins, 0);
+  const bool materialMasks = c.materialCount <= 64;
+  for (int t = 0; t < c.tfCount; ++t) {
+    const TransferFunctionView& tf = c.tfs[t];
+    for (int b = 0; b < kSummaryBins; ++b) {
+      float lo, hi;
+      bins_[tf.proxy].Range(b, &lo, &hi);
+      if (IsMaterialTF(tf.type)) {
+        uint64_t mask = 0;
+        for (int i = 0; i < tf.count; ++i)
+          if (tf.EntryInRange(i, lo, hi)) mask |= 1ull << (tf.materials[i] & 63);
+        binMaterials[(size_t)t * kSummaryBins + b] = mask;
+      } else {
+        float v[kMaxTFChannels];
+        tf.MaxOverRange(lo, hi, v);
+        binMax[(size_t)t * kSummaryBins + b] = v[0];
+      }
+    }
+  }
+
+  // Leaves.
+  const int L = view_.leafLevel;
+  const int64_t leaves = LeafCount();
+  ParallelFor(leaves, options_.threads, [&](int64_t begin, int64_t end) {
+    for (int64_t leaf = begin; leaf < end; ++leaf) {
+      auto summary = [&](int proxy) { return &summaries_[proxy][(size_t)leaf * kSummaryWords]; };
+      // The materials that can occur: the default, and whatever a material
+      // TF can pick from the leaf's bins (all of them if there are too many
+      // materials for a mask).
+      uint64_t candidates = c.defaultMaterial != kNoMaterial ? 1ull << c.defaultMaterial : 0;
+      for (int s = 0; s < c.selectorCount && materialMasks; ++s) {
+        const int t = c.selectors[s];
+        ForEachBin(summary(c.tfs[t].proxy),
+                   [&](int b) { candidates |= binMaterials[(size_t)t * kSummaryBins + b]; });
+      }
+      float majorant = 0.f;
+      for (int m = 0; m < c.materialCount; ++m) {
+        if (materialMasks && !(candidates & (1ull << m))) continue;
+        const MaterialView& mat = c.materials[m];
+        float d = mat.base[0];
+        for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
+          const int t = c.bindings[mat.bindingBegin + b].tf;
+          float mx = 0.f;
+          ForEachBin(summary(c.tfs[t].proxy),
+                     [&](int bin) { mx = std::max(mx, binMax[(size_t)t * kSummaryBins + bin]); });
+          d *= mx;
+        }
+        majorant = std::max(majorant, d);
+      }
+      majorants_[view_.offset[L] + leaf] = majorant;
+    }
+  });
+
+  RefitUpperLevels();
+  refitSeconds_ = SecondsSince(start);
+}
+
+void MajorantGrid::RefitUpperLevels() {
+  // Bottom-up: each node the maximum of its children.
+  for (int l = view_.leafLevel - 1; l >= 0; --l) {
+    const int* r = view_.res[l];
+    const int* rc = view_.res[l + 1];
+    for (int z = 0; z < r[2]; ++z)
+      for (int y = 0; y < r[1]; ++y)
+        for (int x = 0; x < r[0]; ++x) {
+          float mx = 0.f;
+          for (int cz = 2 * z; cz <= std::min(2 * z + 1, rc[2] - 1); ++cz)
+            for (int cy = 2 * y; cy <= std::min(2 * y + 1, rc[1] - 1); ++cy)
+              for (int cx = 2 * x; cx <= std::min(2 * x + 1, rc[0] - 1); ++cx)
+                mx = std::max(mx, majorants_[view_.Index(l + 1, cx, cy, cz)]);
+          majorants_[view_.Index(l, x, y, z)] = mx;
+        }
+  }
+}
+
+}  // namespace mmrtm

@@ -1,0 +1,96 @@
+// The hierarchical majorant grid on the host: TF-independent per-leaf
+// summaries, built once per data load, and the refit of every node's
+// majorant from them when a TF changes (paper section 4, DESIGN.md rule 4).
+//
+// Summary of a leaf, per proxy: the set of value bins (256 bins over the
+// proxy's value range; one bin per label for label maps of at most 256
+// values) that the proxy can take anywhere in the leaf. For a trilinear proxy
+// these are the bins crossed by the interpolant of every voxel cell of the
+// leaf: a cell takes every value between its corner values, and the union of
+// its 12 edge intervals is exactly that range, so the summary unions the
+// intervals of the voxel edges. For a nearest-lookup proxy they are the bins
+// of the voxel values. Each leaf's summary also covers `margin` cells around
+// it, so that a point that rounding puts just outside its node is still
+// bounded.
+//
+// Refit: the maximum of every TF over every bin (once per TF), then each
+// leaf's majorant as the maximum over the materials that can occur in it of
+// base density times the product over its density TFs of their maximum over
+// the leaf's bins; then every parent as the maximum of its children. The cost
+// depends on the number of leaves and bins, not on the number of voxels.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "host_volume.h"
+#include "mmrtm/classifier.h"
+#include "mmrtm/majorant_grid.h"
+
+namespace mmrtm {
+
+enum class SummaryMode : uint8_t {
+  CellRanges,  // conservative: the value ranges the cells can interpolate to
+  VoxelValues  // the paper's refit: the largest extinction at the leaf's voxels,
+               // recomputed from the voxels at every refit; not conservative
+};
+
+struct MajorantGridOptions {
+  int leafLevel = -1;  // -1: chosen so that leaves are about kTargetLeafCells cells wide
+  int margin = 1;      // voxel cells around each leaf included in its summary
+  SummaryMode summary = SummaryMode::CellRanges;
+  int threads = 0;     // 0: all hardware threads
+};
+
+constexpr int kTargetLeafCells = 8;  // the paper's 512^3 volumes at leaf level 6
+constexpr int kSummaryBins = 256;
+constexpr int kSummaryWords = kSummaryBins / 64;
+
+class MajorantGrid {
+ public:
+  // Lays out the levels over proxy 0 and builds every leaf's summary.
+  void Build(const std::vector<HostVolume>& proxies, const MajorantGridOptions& options);
+  // Rebuilds the summaries of the leaves that overlap the voxel box
+  // [lo, hi] (inclusive, in proxy 0's index space) after the data there changed.
+  void UpdateRegion(const std::vector<HostVolume>& proxies, std::array<int, 3> lo, std::array<int, 3> hi);
+  // Recomputes every majorant for the classifier's TFs and materials.
+  void Refit(const Classifier& classifier);
+
+  const MajorantGridView& View() const { return view_; }
+  int LeafLevel() const { return view_.leafLevel; }
+  int64_t LeafCount() const;
+  int64_t NodeCount() const { return (int64_t)majorants_.size(); }
+  double LastBuildSeconds() const { return buildSeconds_; }
+  double LastRefitSeconds() const { return refitSeconds_; }
+  const MajorantGridOptions& Options() const { return options_; }
+
+  // The value bins of a proxy's summary.
+  struct BinMap {
+    float lo = 0.f, width = 1.f;
+    bool discrete = false;  // one bin per integer value
+    int Bin(float v) const;
+    void Range(int bin, float* lo, float* hi) const;  // a value range that contains the bin, with slack
+  };
+  const BinMap& Bins(int proxy) const { return bins_[proxy]; }
+  // Leaf summary words of `proxy` (kSummaryWords per leaf, leaves x fastest).
+  const std::vector<uint64_t>& LeafSummaries(int proxy) const { return summaries_[proxy]; }
+
+ private:
+  void BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3], const int hi[3]);
+  void SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz);
+  void RefitFromVoxelValues(const Classifier& classifier);
+  void RefitUpperLevels();
+
+  MajorantGridOptions options_;
+  MajorantGridView view_;
+  int proxyCount_ = 0;
+  std::array<Affine3, kMaxProxies> leafIndexToProxy_;  // proxy 0 index -> proxy k index
+  std::array<bool, kMaxProxies> sameGrid_{};           // leafIndexToProxy_ is the identity
+  std::array<BinMap, kMaxProxies> bins_;
+  std::array<std::vector<uint64_t>, kMaxProxies> summaries_;
+  std::vector<float> majorants_;
+  double buildSeconds_ = 0, refitSeconds_ = 0;
+};
+
+}  // namespace mmrtm

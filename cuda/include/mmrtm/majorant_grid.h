@@ -1,0 +1,182 @@
+// The hierarchical majorant grid (paper section 4) as the tracker sees it:
+// an octree stored as one uniform grid per level, level 0 the root and level
+// `leafLevel` the leaves, and the iterator that walks it along a ray.
+//
+// Node (x, y, z) of level l covers the voxel cells [x s_l, (x+1) s_l) (and so
+// on for y, z) of the volume's index space, clipped to the volume, with
+// s_l = leafSize * 2^(leafLevel - l). Parent and children follow from the
+// integer coordinates (x >> 1; 2x and 2x + 1), bounds from s_l, so the flat
+// list stores only one majorant per node, level after level.
+//
+// Traversal (paper section 4), in a node of optical thickness
+// tau = sigma_maj * scale * width_l:
+//   - an empty node climbs to its highest empty ancestor, which is skipped;
+//   - tau below kClimbOpticalThickness climbs, unless the parent's tau is
+//     above kDescendOpticalThickness;
+//   - tau above kDescendOpticalThickness descends to the child under the ray;
+//   - otherwise (or at the root or a leaf) the node is one majorant segment,
+//     and the walk continues with its neighbour on the same level (3D-DDA).
+// The paper states its thresholds 0.2 and 0.6 on the "maximum attenuation
+// coefficient" of a node; here they apply to the node's optical thickness
+// (majorant times node width), which makes them independent of units and
+// voxel size: it is the expected number of tentative collisions per node,
+// and what decides whether a finer or coarser node pays off.
+#pragma once
+
+#include "mmrtm/defs.h"
+#include "mmrtm/ray.h"
+
+namespace mmrtm {
+
+constexpr int kMaxGridLevels = 12;
+constexpr float kClimbOpticalThickness = 0.2f;    // paper section 4
+constexpr float kDescendOpticalThickness = 0.6f;  // paper section 4
+
+enum class GridTraversal : uint8_t {
+  Macrocell,  // 3D-DDA over the leaf level only (the uniform-grid baseline)
+  Octree      // the paper's multi-level traversal
+};
+
+struct MajorantGridView {
+  int leafLevel = 0;                       // levels 0..leafLevel
+  int cells[3] = {1, 1, 1};                // voxel cells per axis (n - 1, at least 1)
+  int res[kMaxGridLevels][3] = {};         // nodes per axis, per level
+  int nodeSize[kMaxGridLevels] = {};       // node width in voxel cells, per level
+  int64_t offset[kMaxGridLevels] = {};     // first node of each level in `majorants`
+  float worldWidth[kMaxGridLevels] = {};   // node width in world units (largest axis)
+  const float* majorants = nullptr;        // sigma_t bound of every node, level after level
+
+  MMRTM_CPU_GPU int64_t Index(int level, int x, int y, int z) const {
+    MMRTM_DCHECK(x >= 0 && x < res[level][0] && y >= 0 && y < res[level][1] && z >= 0 && z < res[level][2]);
+    return offset[level] + x + (int64_t)res[level][0] * (y + (int64_t)res[level][1] * z);
+  }
+  MMRTM_CPU_GPU float Majorant(int level, const int c[3]) const { return majorants[Index(level, c[0], c[1], c[2])]; }
+};
+
+// Walks the grid along a ray given in voxel index space (its parameter t is
+// the world distance), handing out majorant segments.
+class GridMajorantIterator {
+ public:
+  GridMajorantIterator() = default;
+  MMRTM_CPU_GPU GridMajorantIterator(const MajorantGridView* grid, GridTraversal traversal, const Ray& r,
+                                     float tMin, float tMax, float scale)
+      : grid_(grid), o_(r.o), d_(r.d), t_(tMin), tEnd_(tMax), scale_(scale), traversal_(traversal) {
+    level_ = traversal == GridTraversal::Macrocell ? grid->leafLevel : 0;
+    Vec3 p = r(tMin);
+    for (int a = 0; a < 3; ++a) {
+      float x = p[a] / (float)grid->nodeSize[level_];
+      cell_[a] = ClampInt((int)floorf(x), 0, grid->res[level_][a] - 1);
+    }
+  }
+
+  // The next segment with a non-zero majorant; false at the end of the ray.
+  MMRTM_CPU_GPU bool Next(float* tMin, float* tMax, float* sigma_maj) {
+    while (t_ < tEnd_) {
+      const float maj = grid_->Majorant(level_, cell_);
+      if (maj <= 0.f) {
+        if (traversal_ == GridTraversal::Octree) ClimbToHighestEmptyAncestor();
+        int axis;
+        float tExit = ExitDistance(&axis);
+        if (!Step(axis, tExit)) return false;
+        continue;
+      }
+      if (traversal_ == GridTraversal::Octree) {
+        const float tau = maj * scale_ * grid_->worldWidth[level_];
+        if (tau < kClimbOpticalThickness && level_ > 0) {
+          const int parent[3] = {cell_[0] >> 1, cell_[1] >> 1, cell_[2] >> 1};
+          if (grid_->Majorant(level_ - 1, parent) * scale_ * grid_->worldWidth[level_ - 1] <=
+              kDescendOpticalThickness) {
+            Climb();
+            continue;
+          }
+        } else if (tau > kDescendOpticalThickness && level_ < grid_->leafLevel) {
+          Descend();
+          continue;
+        }
+      }
+      int axis;
+      const float tExit = ExitDistance(&axis);
+      *tMin = t_;
+      *sigma_maj = maj * scale_;
+      // The last node of the ray takes the rest of [tMin, tMax]: the box test
+      // widens the far end by a few ulps, where lookups clamp to this node.
+      *tMax = Step(axis, tExit) ? tExit : tEnd_;
+      return true;
+    }
+    return false;
+  }
+
+  int Level() const { return level_; }
+
+ private:
+  MMRTM_CPU_GPU void Climb() {
+    --level_;
+    for (int a = 0; a < 3; ++a) cell_[a] >>= 1;
+  }
+
+  MMRTM_CPU_GPU void ClimbToHighestEmptyAncestor() {
+    while (level_ > 0) {
+      int parent[3] = {cell_[0] >> 1, cell_[1] >> 1, cell_[2] >> 1};
+      if (grid_->Majorant(level_ - 1, parent) > 0.f) break;
+      Climb();
+    }
+  }
+
+  // Into the child that the ray is in at t (ties go to the side it heads to).
+  MMRTM_CPU_GPU void Descend() {
+    const int child = level_ + 1;
+    const float size = (float)grid_->nodeSize[child];
+    Vec3 p = o_ + d_ * t_;
+    for (int a = 0; a < 3; ++a) {
+      float mid = (float)(2 * cell_[a] + 1) * size;
+      float rel = p[a] - mid;
+      bool upper = fabsf(rel) <= 1e-4f * size ? d_[a] > 0.f : rel > 0.f;
+      cell_[a] = ClampInt(2 * cell_[a] + (upper ? 1 : 0), 0, grid_->res[child][a] - 1);
+    }
+    level_ = child;
+  }
+
+  // Where the ray leaves the current node, and through which face (-1 when
+  // the ray ends inside it).
+  MMRTM_CPU_GPU float ExitDistance(int* axisOut) const {
+    const float size = (float)grid_->nodeSize[level_];
+    float tExit = tEnd_;
+    int axis = -1;
+    for (int a = 0; a < 3; ++a) {
+      if (d_[a] == 0.f) continue;
+      float plane = d_[a] > 0.f ? Min((float)(cell_[a] + 1) * size, (float)grid_->cells[a]) : (float)cell_[a] * size;
+      float t = (plane - o_[a]) / d_[a];
+      if (t < tExit) {
+        tExit = t;
+        axis = a;
+      }
+    }
+    *axisOut = axis;
+    return Max(tExit, t_);
+  }
+
+  // Moves to the neighbour across face `axis` at tExit; false when the ray
+  // leaves the grid or ends.
+  MMRTM_CPU_GPU bool Step(int axis, float tExit) {
+    t_ = tExit;
+    if (axis < 0 || t_ >= tEnd_) {
+      t_ = tEnd_;
+      return false;
+    }
+    cell_[axis] += d_[axis] > 0.f ? 1 : -1;
+    if (cell_[axis] < 0 || cell_[axis] >= grid_->res[level_][axis]) {
+      t_ = tEnd_;
+      return false;
+    }
+    return true;
+  }
+
+  const MajorantGridView* grid_ = nullptr;
+  Vec3 o_, d_;
+  float t_ = 0.f, tEnd_ = 0.f, scale_ = 1.f;
+  int level_ = 0;
+  int cell_[3] = {0, 0, 0};
+  GridTraversal traversal_ = GridTraversal::Octree;
+};
+
+}  // namespace mmrtm
