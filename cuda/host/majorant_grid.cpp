@@ -90,8 +90,9 @@ void MajorantGrid::BinMap::Range(int bin, float* rangeLo, float* rangeHi) const 
     *rangeLo = lo + bin - 0.25f;
     *rangeHi = lo + bin + 0.25f;
   } else {
-    // Slack for the rounding of Bin(); the last bin also holds everything above.
-    const float slack = 1e-3f * width;
+    // Slack for positions rounded across a node face, and for the rounding of
+    // Bin(); the first and last bins also hold everything beyond them.
+    const float slack = this->slack + 1e-3f * width;
     *rangeLo = lo + bin * width - slack;
     *rangeHi = bin == kSummaryBins - 1 ? kInfinity : lo + (bin + 1) * width + slack;
     if (bin == 0) *rangeLo = -kInfinity;
@@ -116,11 +117,21 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
     view_.cells[a] = std::max(v0.dims[a] - 1, 1);
     maxCells = std::max(maxCells, view_.cells[a]);
   }
+  auto leafSizeAt = [&](int level) { return std::max(1, (int)std::ceil((double)maxCells / (double)(1 << level))); };
+  auto leavesAt = [&](int level) {
+    int64_t n = 1;
+    for (int a = 0; a < 3; ++a) n *= (view_.cells[a] + leafSizeAt(level) - 1) / leafSizeAt(level);
+    return n;
+  };
   int leafLevel = options.leafLevel;
-  if (leafLevel < 0) leafLevel = (int)std::ceil(std::log2(std::max(1.0, (double)maxCells / kTargetLeafCells)));
+  if (leafLevel < 0) {
+    leafLevel = 0;
+    while (leafLevel + 1 < kMaxGridLevels && leafSizeAt(leafLevel) > 1 && leavesAt(leafLevel + 1) <= kMaxAutoLeaves)
+      ++leafLevel;
+  }
   leafLevel = std::clamp(leafLevel, 0, kMaxGridLevels - 1);
   view_.leafLevel = leafLevel;
-  const int leafSize = std::max(1, (int)std::ceil((double)maxCells / (double)(1 << leafLevel)));
+  const int leafSize = leafSizeAt(leafLevel);
   float maxSpacing = 0.f;
   for (int a = 0; a < 3; ++a)
     maxSpacing = std::max(maxSpacing, Length(Vec3{v0.indexToWorld.m[0][a], v0.indexToWorld.m[1][a],
@@ -150,6 +161,7 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
     b.discrete = v.interpolation == Interpolation::Nearest && integral && range[1] - range[0] < kSummaryBins;
     b.width = b.discrete ? 1.f : std::max((range[1] - range[0]) / kSummaryBins, 1e-30f);
     if (!(range[1] > range[0])) b.width = 1.f;
+    b.slack = v.interpolation == Interpolation::Trilinear ? kPositionTolerance * (range[1] - range[0]) : 0.f;
     if (options_.summary == SummaryMode::VoxelValues) continue;
     leafIndexToProxy_[k] = AffineCompose(v.View().worldToIndex, v0.indexToWorld);
     sameGrid_[k] = AffineIsIdentity(leafIndexToProxy_[k], 1e-5f) && v.dims == v0.dims;

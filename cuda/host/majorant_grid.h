@@ -9,9 +9,18 @@
 // leaf: a cell takes every value between its corner values, and the union of
 // its 12 edge intervals is exactly that range, so the summary unions the
 // intervals of the voxel edges. For a nearest-lookup proxy they are the bins
-// of the voxel values. Each leaf's summary also covers `margin` cells around
-// it, so that a point that rounding puts just outside its node is still
-// bounded.
+// of the voxel values.
+//
+// Rounding: a point that rounding puts a distance e (in voxels) outside its
+// node takes a value within e * (max - min) of the value at the node's face,
+// which the node's cells do cover (the trilinear interpolant changes by at
+// most max - min per voxel). So each bin's value range is widened by
+// kPositionTolerance * (max - min) when the TFs are bounded over it; with
+// kPositionTolerance = 1e-3 voxel, far above float rounding of positions
+// (about 1e-4 voxel for index coordinates up to a few thousand). Label maps
+// need no widening: a leaf face lies on voxel centres, half a voxel from any
+// change of nearest voxel. `margin` adds whole cells around each leaf instead,
+// if ever needed.
 //
 // Refit: the maximum of every TF over every bin (once per TF), then each
 // leaf's majorant as the maximum over the materials that can occur in it of
@@ -37,13 +46,19 @@ enum class SummaryMode : uint8_t {
 };
 
 struct MajorantGridOptions {
-  int leafLevel = -1;  // -1: chosen so that leaves are about kTargetLeafCells cells wide
-  int margin = 1;      // voxel cells around each leaf included in its summary
+  int leafLevel = -1;  // -1: the finest level with at most kMaxAutoLeaves leaves
+  int margin = 0;      // voxel cells around each leaf included in its summary
   SummaryMode summary = SummaryMode::CellRanges;
   int threads = 0;     // 0: all hardware threads
 };
 
-constexpr int kTargetLeafCells = 8;  // the paper's 512^3 volumes at leaf level 6
+// The automatic leaf level: the finest whose leaf count stays within this
+// budget. Finer leaves give tighter majorants (fewer null collisions) but a
+// refit costs time per leaf; 2^19 leaves refit in about 15 ms on 2 CPU cores
+// (Documentation/performance.md). A 512^3 volume gets 8-cell leaves (the
+// paper's level 6), a 256^3 one 4-cell leaves.
+constexpr int64_t kMaxAutoLeaves = int64_t(1) << 19;
+constexpr float kPositionTolerance = 1e-3f;  // voxels; see "Rounding" above
 constexpr int kSummaryBins = 256;
 constexpr int kSummaryWords = kSummaryBins / 64;
 
@@ -68,6 +83,7 @@ class MajorantGrid {
   // The value bins of a proxy's summary.
   struct BinMap {
     float lo = 0.f, width = 1.f;
+    float slack = 0.f;      // widening of every bin's value range (see "Rounding")
     bool discrete = false;  // one bin per integer value
     int Bin(float v) const;
     void Range(int bin, float* lo, float* hi) const;  // a value range that contains the bin, with slack
