@@ -101,25 +101,16 @@ struct Result {
   uint64_t violations = 0;
 };
 
-double MeanZ2(const Film& a, const Film& b) {
-  double sum = 0;
-  int n = 0;
-  for (int y = 0; y < a.Height(); ++y)
-    for (int x = 0; x < a.Width(); ++x)
-      for (int c = 0; c < 3; ++c) {
-        const double v = a.VarianceOfMean(x, y)[c] + b.VarianceOfMean(x, y)[c];
-        if (v < 1e-9) continue;
-        const double d = a.Mean(x, y)[c] - b.Mean(x, y)[c];
-        sum += d * d / v;
-        ++n;
-      }
-  return n ? sum / n : 0.0;
-}
 
-// Nearest and farthest non-empty point along every camera ray (pixel centres).
-double Locate(const SceneView& s, int width) {
+// Nearest and farthest non-empty point along every camera ray (pixel
+// centres): the majorant segments say where the volume may be non-empty; the
+// first (last) of them is searched in steps of half the smallest voxel
+// spacing for the first (last) point with sigma_t > 0. With no accelerator
+// the one segment is the whole box, so the whole ray is searched.
+double Locate(const SceneView& s, int width, float step) {
   CameraView cam = s.camera;
   cam.width = cam.height = width;
+  auto nonEmpty = [&](const Ray& ray, float t) { return s.classifier.Classify(ray(t)).sigma_t > 0.f; };
   const auto start = Clock::now();
   double checksum = 0;
   for (int y = 0; y < width; ++y)
@@ -131,11 +122,15 @@ double Locate(const SceneView& s, int width) {
       MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, 1.f);
       RayMajorantSegment seg;
       float nearest = -1.f, farthest = -1.f;
+      std::vector<RayMajorantSegment> segments;
       while (it.Next(&seg))
-        if (seg.sigma_maj > 0.f) {
-          if (nearest < 0.f) nearest = seg.tMin;
-          farthest = seg.tMax;
-        }
+        if (seg.sigma_maj > 0.f) segments.push_back(seg);
+      for (size_t i = 0; i < segments.size() && nearest < 0.f; ++i)
+        for (float t = segments[i].tMin; t <= segments[i].tMax && nearest < 0.f; t += step)
+          if (nonEmpty(ray, t)) nearest = t;
+      for (size_t i = segments.size(); i-- > 0 && farthest < 0.f && nearest >= 0.f;)
+        for (float t = segments[i].tMax; t >= segments[i].tMin && farthest < 0.f; t -= step)
+          if (nonEmpty(ray, t)) farthest = t;
       checksum += nearest + farthest;
     }
   const double seconds = Seconds(start);
@@ -238,7 +233,12 @@ int main(int argc, char** argv) {
         std::sort(refits.begin(), refits.end());
         r.refit = refits[refits.size() / 2];
       }
-      r.locate = Locate(view, width);
+      float minSpacing = kInfinity;
+      for (int a = 0; a < 3; ++a)
+        minSpacing = std::min(minSpacing, Length(Vec3{scene.proxies[0].indexToWorld.m[0][a],
+                                                      scene.proxies[0].indexToWorld.m[1][a],
+                                                      scene.proxies[0].indexToWorld.m[2][a]}));
+      r.locate = Locate(view, width, 0.5f * minSpacing);
       Film film(width, width);
       TraceCounters ctr;
       const auto start = Clock::now();
@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
         noneRender = r.render;
         noneFilm = film;
       }
-      r.meanZ2 = MeanZ2(noneFilm, film);
+      r.meanZ2 = MeanSquaredZScore(noneFilm, film);
       results.push_back(r);
       std::printf("%-20s %-20s %5d %9.2f %9.2f %9.1f %9.2f %8.2f %8.2f %7.3f%s\n", d.name.c_str(), c.name.c_str(),
                   r.leafLevel, r.build * 1e3, r.refit * 1e3, r.locate * 1e3, r.render, noneRender / r.render,

@@ -205,22 +205,6 @@ TEST(Refit, AfterADataChangeInARegionEqualsAFullRebuild) {
     ASSERT_EQ(updated.majorants.grid.majorants[i], rebuilt.Grid()->View().majorants[i]) << "node " << i;
 }
 
-// Per-pixel z-test between two renders of the same scene.
-double MeanZ2(const Film& a, const Film& b) {
-  double sum = 0;
-  int n = 0;
-  for (int y = 0; y < a.Height(); ++y)
-    for (int x = 0; x < a.Width(); ++x)
-      for (int c = 0; c < 3; ++c) {
-        const double v = a.VarianceOfMean(x, y)[c] + b.VarianceOfMean(x, y)[c];
-        if (v < 1e-9) continue;
-        const double d = a.Mean(x, y)[c] - b.Mean(x, y)[c];
-        sum += d * d / v;
-        ++n;
-      }
-  return n ? sum / n : 0.0;
-}
-
 Film RenderWith(Scene& scene, MajorantKind kind, uint64_t seed) {
   scene.render.accelerator.kind = kind;
   scene.render.integrator.seed = seed;
@@ -242,17 +226,18 @@ TEST(Unbiased, AcceleratorsAgreeWithinNoise) {
   Film none = RenderWith(scene, MajorantKind::Global, 1);
   Film macrocell = RenderWith(scene, MajorantKind::Macrocell, 2);
   Film octree = RenderWith(scene, MajorantKind::Octree, 3);
-  EXPECT_LT(MeanZ2(none, macrocell), 1.3);
-  EXPECT_LT(MeanZ2(none, octree), 1.3);
+  EXPECT_LT(MeanSquaredZScore(none, macrocell), 1.3);
+  EXPECT_LT(MeanSquaredZScore(none, octree), 1.3);
   // After a TF change and refit, the octree still agrees with the global majorant.
   scene.tfs[0] = CCTF({1800.f, 2600.f}, {0.f, 1.f});  // only the densest bone remains
   Film octreeAfter = RenderWith(scene, MajorantKind::Octree, 4);
   Film noneAfter = RenderWith(scene, MajorantKind::Global, 5);
-  EXPECT_LT(MeanZ2(noneAfter, octreeAfter), 1.3);
+  EXPECT_LT(MeanSquaredZScore(noneAfter, octreeAfter), 1.3);
   // ...and the test can tell the two TFs apart.
-  EXPECT_GT(MeanZ2(none, octreeAfter), 2.0);
+  EXPECT_GT(MeanSquaredZScore(none, octreeAfter), 2.0);
   std::printf("mean z^2: none/macrocell %.3f, none/octree %.3f, after refit %.3f, old/new TF %.3f\n",
-              MeanZ2(none, macrocell), MeanZ2(none, octree), MeanZ2(noneAfter, octreeAfter), MeanZ2(none, octreeAfter));
+              MeanSquaredZScore(none, macrocell), MeanSquaredZScore(none, octree),
+              MeanSquaredZScore(noneAfter, octreeAfter), MeanSquaredZScore(none, octreeAfter));
 }
 
 }  // namespace

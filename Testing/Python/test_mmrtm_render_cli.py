@@ -86,6 +86,20 @@ class RenderCli(unittest.TestCase):
     def test_label_preset_without_labels(self):
         self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-angio-labels"), "no proxy volume named 'labels'")
 
+    def test_accelerators_cut_density_lookups(self):
+        lookups = {}
+        for accelerator in ["none", "macrocell", "octree", "octree-voxelmax"]:
+            stats = os.path.join(self.dir, accelerator + ".json")
+            r = self.run_render(HEADSQ, "--accelerator", accelerator, "--width", "32", "--height", "32",
+                                "--spp", "4", "--stats-json", stats)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(stats) as f:
+                s = json.load(f)
+            self.assertGreater(s["real_collisions"], 0)
+            lookups[accelerator] = s["density_lookups_per_real_collision"]
+        self.assertLess(lookups["octree"], lookups["none"] / 2, lookups)
+        self.assertLess(lookups["macrocell"], lookups["none"] / 2, lookups)
+
     def test_missing_input(self):
         self.expect_failure(self.run_render(os.path.join(self.dir, "nope.nrrd")), "nope.nrrd")
 
@@ -130,6 +144,7 @@ class RenderCli(unittest.TestCase):
     def test_bad_option_value(self):
         self.expect_failure(self.run_render(HEADSQ, "--spp", "many"), "--spp", code=2)
         self.expect_failure(self.run_render(HEADSQ, "--frobnicate"), "unknown option", code=2)
+        self.expect_failure(self.run_render(HEADSQ, "--accelerator", "kd-tree"), "--accelerator", code=2)
 
     def test_output_folder_missing(self):
         r = subprocess.run([RENDER, HEADSQ, "--output", os.path.join(self.dir, "no", "out.png"), "--quiet"],

@@ -60,4 +60,19 @@ std::vector<uint8_t> Film::ToneMapped(float exposure, ToneMapper op, int channel
   return out;
 }
 
+double MeanSquaredZScore(const Film& a, const Film& b) {
+  double sum = 0;
+  int64_t n = 0;
+  for (int y = 0; y < a.Height(); ++y)
+    for (int x = 0; x < a.Width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double v = a.VarianceOfMean(x, y)[c] + b.VarianceOfMean(x, y)[c];
+        if (v < 1e-9) continue;
+        const double d = a.Mean(x, y)[c] - b.Mean(x, y)[c];
+        sum += d * d / v;
+        ++n;
+      }
+  return n ? sum / n : 0.0;
+}
+
 }  // namespace mmrtm

@@ -17,6 +17,14 @@ struct NoiseEstimate {
   double relative = 0;          // rmsStandardError / meanLuminance
 };
 
+class Film;
+
+// Agreement of two renders of the same scene within their noise: the mean
+// over pixels and channels of z^2 = (a - b)^2 / (var_a + var_b), skipping
+// pixels without variance (e.g. the background). About 1 when the two
+// estimate the same image, 0 for identical images, well above 1 when they differ.
+double MeanSquaredZScore(const Film& a, const Film& b);
+
 class Film {
  public:
   Film(int width, int height);

@@ -37,7 +37,6 @@ void Scene::Validate() const {
   if ((int)proxies.size() > kMaxProxies)
     throw InputError("scene: " + std::to_string(proxies.size()) + " proxy volumes; at most " +
                      std::to_string(kMaxProxies) + " are supported");
-  for (const HostVolume& v : proxies) v.Validate();
   if (materials.empty()) throw InputError("scene: no material");
   if (gradientProxy < 0 || gradientProxy >= (int)proxies.size()) throw InputError("scene: bad gradient proxy");
   for (const TransferFunctionDesc& tf : tfs) {
@@ -97,8 +96,7 @@ float Scene::GlobalMajorant() const {
   // Each material's density is bounded by its base times the maximum of each
   // density TF over its proxy's whole value range; the classified density is
   // one of these, so their maximum bounds sigma_t everywhere.
-  std::vector<std::array<float, 2>> ranges;
-  for (const HostVolume& v : proxies) ranges.push_back(v.ValueRange());
+  const std::vector<std::array<float, 2>>& ranges = valueRanges_;
   float majorant = 0.f;
   for (size_t m = 0; m < materialViews_.size(); ++m) {
     const MaterialView& mv = materialViews_[m];
@@ -151,6 +149,16 @@ CameraView Scene::BuildCamera() const {
 
 SceneView Scene::Build() {
   Validate();
+  // What depends on the voxels alone is checked and measured once per data
+  // load, so that a TF change costs only the refit.
+  dataModified_ = dataModified_ || valueRanges_.size() != proxies.size();
+  if (dataModified_ || !modifiedRegions_.empty()) {
+    valueRanges_.clear();
+    for (const HostVolume& v : proxies) {
+      v.Validate();
+      valueRanges_.push_back(v.ValueRange());
+    }
+  }
 
   // Flatten the TFs: offsets first (the pools must not reallocate under the views).
   floatPool_.clear();

@@ -104,7 +104,8 @@ class Scene {
   // Throws InputError naming the problem.
   SceneView Build();
 
-  // sigma_t bound over the whole volume (the "none" accelerator's majorant).
+  // sigma_t bound over the whole volume (the "none" accelerator's majorant),
+  // from the TFs as of the last Build.
   float GlobalMajorant() const;
 
   // After the voxels of a proxy change: the next Build rebuilds the grid's
@@ -127,6 +128,7 @@ class Scene {
   std::vector<CoefficientBinding> bindings_;
   std::vector<Light> lightViews_;
   std::unique_ptr<MajorantGrid> grid_;
+  std::vector<std::array<float, 2>> valueRanges_;  // per proxy, at the last data load
   bool dataModified_ = true;
   std::vector<std::array<std::array<int, 3>, 2>> modifiedRegions_;
 };

@@ -36,60 +36,67 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, f
   return c;
 }
 
-MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
-                                               TraceCounters& ctr) {
-  FreePathResult r;
+// Walks the tentative collisions of a ray up to tMax (pbrt-v4's
+// SampleT_maj): exponential steps with each majorant segment's sigma_maj,
+// restarting at each segment (the exponential is memoryless), and calls
+// visit(t, classification, sigma_maj) at each until visit returns false or
+// the ray ends. `scale` multiplies the extinction and the majorants.
+template <typename Visit>
+MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
+                                                    PCG32& rng, TraceCounters& ctr, Visit visit) {
   Ray indexRay;
   float t0, t1;
-  if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return r;
-  MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, 1.f);
-  RayMajorantSegment seg;
-  while (it.Next(&seg)) {
-    ++ctr.majorantSegments;
-    if (seg.sigma_maj <= 0.f) continue;
-    float t = seg.tMin;
-    for (;;) {
-      t -= logf(1.f - rng.Uniform()) / seg.sigma_maj;
-      if (t >= seg.tMax) break;  // memoryless: restart at the next segment
-      Classification c = LookupAndCount(s, ray(t), seg.sigma_maj, 1.f, ctr);
-      if (rng.Uniform() * seg.sigma_maj < c.sigma_t) {
-        ++ctr.realCollisions;
-        r.collided = true;
-        r.t = t;
-        r.c = c;
-        return r;
-      }
-      ++ctr.nullCollisions;
-    }
-  }
-  return r;
-}
-
-// Transmittance along ray up to tMax, with sigma_t scaled by `scale`.
-MMRTM_CPU_GPU inline float RatioTrack(const SceneView& s, const Ray& ray, float tMax, float scale, PCG32& rng,
-                                      TraceCounters& ctr) {
-  ++ctr.shadowRays;
-  Ray indexRay;
-  float t0, t1;
-  if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return 1.f;
+  if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
   MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, scale);
   RayMajorantSegment seg;
-  float T = 1.f;
   while (it.Next(&seg)) {
     ++ctr.majorantSegments;
     if (seg.sigma_maj <= 0.f) continue;
-    float t = seg.tMin;
-    for (;;) {
+    for (float t = seg.tMin;;) {
       t -= logf(1.f - rng.Uniform()) / seg.sigma_maj;
       if (t >= seg.tMax) break;
       Classification c = LookupAndCount(s, ray(t), seg.sigma_maj, scale, ctr);
-      T *= Max(0.f, 1.f - scale * c.sigma_t / seg.sigma_maj);
-      if (T < kRatioRouletteThreshold) {
-        if (rng.Uniform() >= kRatioSurvival) return 0.f;
-        T /= kRatioSurvival;
-      }
+      if (!visit(t, c, seg.sigma_maj)) return;
     }
   }
+}
+
+// Delta tracking: a tentative collision is real with probability
+// sigma_t / sigma_maj.
+MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
+                                               TraceCounters& ctr) {
+  FreePathResult r;
+  SampleTentativeCollisions(s, ray, tMax, 1.f, rng, ctr, [&](float t, const Classification& c, float sigma_maj) {
+    if (rng.Uniform() * sigma_maj < c.sigma_t) {
+      ++ctr.realCollisions;
+      r.collided = true;
+      r.t = t;
+      r.c = c;
+      return false;
+    }
+    ++ctr.nullCollisions;
+    return true;
+  });
+  return r;
+}
+
+// Ratio tracking: transmittance along ray up to tMax, with sigma_t scaled by
+// `scale`, as the product of the null-collision probabilities.
+MMRTM_CPU_GPU inline float RatioTrack(const SceneView& s, const Ray& ray, float tMax, float scale, PCG32& rng,
+                                      TraceCounters& ctr) {
+  ++ctr.shadowRays;
+  float T = 1.f;
+  SampleTentativeCollisions(s, ray, tMax, scale, rng, ctr, [&](float, const Classification& c, float sigma_maj) {
+    T *= Max(0.f, 1.f - scale * c.sigma_t / sigma_maj);
+    if (T < kRatioRouletteThreshold) {
+      if (rng.Uniform() >= kRatioSurvival) {
+        T = 0.f;
+        return false;
+      }
+      T /= kRatioSurvival;
+    }
+    return true;
+  });
   return T;
 }
 

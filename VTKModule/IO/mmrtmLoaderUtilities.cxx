@@ -1,0 +1,158 @@
+// Helpers the volume loader's format files share: small string and number
+// helpers, and the conversion of stored voxels (any file type, optional
+// rescale) into a HostVolume's native voxel types.
+#include "mmrtmVolumeLoaderInternal.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <utility>
+
+namespace mmrtm {
+
+// ---------------------------------------------------------------------------
+// Small helpers
+// ---------------------------------------------------------------------------
+
+std::string ToLower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return (char)std::tolower(c); });
+  return s;
+}
+
+std::string Trim(const std::string& s) {
+  const char* space = " \t\r\n\f\v";
+  size_t b = s.find_first_not_of(space);
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(space) - b + 1);
+}
+
+std::vector<double> ParseNumbers(const std::string& text) {
+  std::vector<double> out;
+  std::istringstream in(text);
+  std::string token;
+  while (in >> token) {
+    char* end = nullptr;
+    double v = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0') break;
+    out.push_back(v);
+  }
+  return out;
+}
+
+Vec3d Cross(const Vec3d& a, const Vec3d& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double Dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+[[noreturn]] void ThrowComponents(const std::string& path, int64_t components) {
+  throw InputError(path + ": has " + std::to_string(components) +
+                   " components; a single-component volume is needed");
+}
+
+// ---------------------------------------------------------------------------
+// Voxel conversion
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// Calls f with the data pointer cast to the C++ type of `type`.
+template <typename F>
+void WithTypedPointer(SourceType type, const void* data, F&& f) {
+  switch (type) {
+    case SourceType::Int8: f(static_cast<const int8_t*>(data)); break;
+    case SourceType::UInt8: f(static_cast<const uint8_t*>(data)); break;
+    case SourceType::Int16: f(static_cast<const int16_t*>(data)); break;
+    case SourceType::UInt16: f(static_cast<const uint16_t*>(data)); break;
+    case SourceType::Int32: f(static_cast<const int32_t*>(data)); break;
+    case SourceType::UInt32: f(static_cast<const uint32_t*>(data)); break;
+    case SourceType::Int64: f(static_cast<const int64_t*>(data)); break;
+    case SourceType::UInt64: f(static_cast<const uint64_t*>(data)); break;
+    case SourceType::Float32: f(static_cast<const float*>(data)); break;
+    case SourceType::Float64: f(static_cast<const double*>(data)); break;
+  }
+}
+
+// The types the tracer stores as they are (DESIGN.md rule 3).
+std::optional<VoxelType> NativeVoxelType(SourceType t) {
+  switch (t) {
+    case SourceType::UInt8: return VoxelType::UInt8;
+    case SourceType::Int16: return VoxelType::Int16;
+    case SourceType::UInt16: return VoxelType::UInt16;
+    case SourceType::Float32: return VoxelType::Float32;
+    default: return std::nullopt;
+  }
+}
+
+struct ValueStats {
+  bool allIntegers = true;
+  double lo = std::numeric_limits<double>::infinity(), hi = -std::numeric_limits<double>::infinity();
+};
+
+template <typename T>
+ValueStats ScanValues(const T* p, int64_t n, Rescale r) {
+  ValueStats s;
+  for (int64_t i = 0; i < n; ++i) {
+    const double v = (double)p[i] * r.slope + r.intercept;
+    if (!(std::isfinite(v) && v == std::floor(v))) s.allIntegers = false;  // NaN fails too
+    s.lo = std::min(s.lo, v);
+    s.hi = std::max(s.hi, v);
+  }
+  return s;
+}
+
+// The smallest integer type that holds every value exactly, else float32.
+// int16 is preferred over uint16 when both fit: CT and most medical data are signed.
+VoxelType SmallestExactType(const ValueStats& s) {
+  if (!s.allIntegers) return VoxelType::Float32;
+  if (s.lo >= 0 && s.hi <= 255) return VoxelType::UInt8;
+  if (s.lo >= -32768 && s.hi <= 32767) return VoxelType::Int16;
+  if (s.lo >= 0 && s.hi <= 65535) return VoxelType::UInt16;
+  return VoxelType::Float32;
+}
+
+template <typename Out, typename In>
+void ConvertValues(const In* in, int64_t n, Rescale r, uint8_t* outBytes) {
+  Out* out = reinterpret_cast<Out*>(outBytes);
+  for (int64_t i = 0; i < n; ++i) out[i] = static_cast<Out>((double)in[i] * r.slope + r.intercept);
+}
+
+}  // namespace
+
+void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out) {
+  if (const auto native = NativeVoxelType(type); native && rescale.IsIdentity()) {
+    out.type = *native;
+    const auto* bytes = static_cast<const uint8_t*>(data);
+    out.voxels.assign(bytes, bytes + count * VoxelTypeSize(*native));
+    return;
+  }
+  // float32 stays float32 after a rescale; every other type may become an
+  // integer type when its (rescaled) values allow it.
+  VoxelType target = VoxelType::Float32;
+  if (type != SourceType::Float32)
+    WithTypedPointer(type, data, [&](auto* p) { target = SmallestExactType(ScanValues(p, count, rescale)); });
+  out.type = target;
+  out.voxels.resize((size_t)(count * VoxelTypeSize(target)));
+  WithTypedPointer(type, data, [&](auto* p) {
+    switch (target) {
+      case VoxelType::UInt8: ConvertValues<uint8_t>(p, count, rescale, out.voxels.data()); break;
+      case VoxelType::Int16: ConvertValues<int16_t>(p, count, rescale, out.voxels.data()); break;
+      case VoxelType::UInt16: ConvertValues<uint16_t>(p, count, rescale, out.voxels.data()); break;
+      case VoxelType::Float32: ConvertValues<float>(p, count, rescale, out.voxels.data()); break;
+    }
+  });
+}
+
+void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock) {
+  const size_t run = (size_t)runVoxels * VoxelTypeSize(v.type), block = run * (size_t)runsPerBlock;
+  if (run == 0 || block == 0) return;
+  for (size_t b = 0; b + block <= v.voxels.size(); b += block)
+    for (int64_t lo = 0, hi = runsPerBlock - 1; lo < hi; ++lo, --hi)
+      std::swap_ranges(v.voxels.begin() + b + lo * run, v.voxels.begin() + b + (lo + 1) * run,
+                       v.voxels.begin() + b + hi * run);
+}
+
+}  // namespace mmrtm

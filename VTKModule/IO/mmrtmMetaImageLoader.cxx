@@ -1,0 +1,151 @@
+// MetaImage volumes (.mha, .mhd) through vtkMetaImageReader, with the
+// geometry (Offset, ElementSpacing, TransformMatrix) read from the header
+// text and a check that the voxel data is all there.
+#include "mmrtmVolumeLoaderInternal.h"
+
+#include <zlib.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <map>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkMetaImageReader.h>
+#include <vtkNew.h>
+
+namespace fs = std::filesystem;
+
+namespace mmrtm {
+
+// vtkMetaImageReader ignores TransformMatrix, so the geometry comes from the
+// header text. As in ITK, TransformMatrix lists the direction of axis 0, then
+// of axis 1, then of axis 2, in LPS; AnatomicalOrientation is ignored (ITK
+// does the same on reading).
+
+namespace {
+
+struct MetaImageHeader {
+  std::map<std::string, std::string> fields;  // "Key = Value" pairs
+  uint64_t size = 0;                          // bytes up to and including the ElementDataFile line
+};
+
+MetaImageHeader ReadMetaImageHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  MetaImageHeader h;
+  std::string line;
+  while (h.size < (1u << 20) && std::getline(in, line)) {
+    h.size += line.size() + 1;
+    const size_t eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string key = Trim(line.substr(0, eq));
+    h.fields[key] = Trim(line.substr(eq + 1));
+    if (key == "ElementDataFile") break;
+  }
+  return h;
+}
+
+// The number of bytes the zlib (or gzip) stream at `offset` of `file`
+// inflates to. Throws if the stream is damaged or cut short.
+uint64_t InflatedSize(const std::string& file, uint64_t offset, const std::string& where) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in.seekg((std::streamoff)offset)) throw InputError(where + ": cannot read " + file);
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(where + ": zlib failed to start");  // +32: zlib or gzip
+  std::vector<unsigned char> input(1 << 16), output(1 << 18);
+  uint64_t total = 0;
+  int ret = Z_OK;
+  while (ret != Z_STREAM_END) {
+    if (zs.avail_in == 0) {
+      in.read(reinterpret_cast<char*>(input.data()), (std::streamsize)input.size());
+      if (in.gcount() == 0) break;
+      zs.next_in = input.data();
+      zs.avail_in = (uInt)in.gcount();
+    }
+    zs.next_out = output.data();
+    zs.avail_out = (uInt)output.size();
+    ret = inflate(&zs, Z_NO_FLUSH);
+    if (ret != Z_OK && ret != Z_STREAM_END && ret != Z_BUF_ERROR) break;
+    total += output.size() - zs.avail_out;
+  }
+  inflateEnd(&zs);
+  if (ret != Z_STREAM_END)
+    throw InputError(where + ": compressed voxel data in " + fs::path(file).filename().string() +
+                     " is damaged or cut short (truncated?)");
+  return total;
+}
+
+// metaio reports a short or damaged data file only on the console and
+// returns what it read, so check that all `bytes` of voxel data are there.
+// Data split over several files (LIST, patterns) is left to the reader.
+void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint64_t bytes) {
+  auto field = [&](const char* key) {
+    auto it = h.fields.find(key);
+    return it == h.fields.end() ? std::string() : it->second;
+  };
+  const std::string dataName = field("ElementDataFile");
+  if (dataName.empty() || dataName == "LIST" || dataName.find('%') != std::string::npos) return;
+  const long headerSize = field("HeaderSize").empty() ? 0 : std::atol(field("HeaderSize").c_str());
+  if (headerSize < 0) return;  // -1: data at the end of the file, any size
+  const bool local = dataName == "LOCAL";
+  const std::string dataFile = local ? path : (fs::path(path).parent_path() / dataName).string();
+  const uint64_t offset = (local ? h.size : 0) + (uint64_t)headerSize;
+  std::error_code ec;
+  const uint64_t fileSize = fs::file_size(dataFile, ec);
+  if (ec) throw InputError(path + ": cannot open its data file " + dataName);
+  const bool compressed = ToLower(field("CompressedData")) == "true";
+  const uint64_t available =
+      compressed ? InflatedSize(dataFile, offset, path) : (fileSize > offset ? fileSize - offset : 0);
+  if (available < bytes)
+    throw InputError(path + ": voxel data is " + std::to_string(available) + " bytes, expected " +
+                     std::to_string(bytes) + " (truncated?)");
+}
+
+// The first of `keys` present with exactly `n` numbers.
+std::optional<std::vector<double>> MetaNumbers(const std::map<std::string, std::string>& fields,
+                                               std::initializer_list<const char*> keys, size_t n) {
+  for (const char* key : keys) {
+    auto it = fields.find(key);
+    if (it == fields.end()) continue;
+    std::vector<double> v = ParseNumbers(it->second);
+    if (v.size() == n) return v;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+void LoadMetaImage(const std::string& path, HostVolume& out) {
+  const MetaImageHeader header = ReadMetaImageHeader(path);
+  const auto& fields = header.fields;
+  if (fields.find("ObjectType") == fields.end() && fields.find("NDims") == fields.end())
+    throw InputError(path + ": not a MetaImage header (no ObjectType or NDims)");
+  vtkNew<vtkMetaImageReader> reader;
+  reader->SetFileName(path.c_str());
+  vtkImageData* image = RunReader(reader, path);
+  vtkDataArray* a = VoxelArray(image, path);
+  CheckMetaImageData(path, header, (uint64_t)a->GetNumberOfValues() * (uint64_t)a->GetDataTypeSize());
+  StoreImageVoxels(image, path, Rescale{}, out);
+
+  // 2D images (NDims 2) keep VTK's origin and spacing, with an identity direction.
+  const double* o = image->GetOrigin();
+  const double* s = image->GetSpacing();
+  Vec3d origin{o[0], o[1], o[2]}, spacing{s[0], s[1], s[2]};
+  Mat3d direction = kIdentity3;
+  if (auto v = MetaNumbers(fields, {"Offset", "Position", "Origin"}, 3)) origin = {(*v)[0], (*v)[1], (*v)[2]};
+  if (auto v = MetaNumbers(fields, {"ElementSpacing", "ElementSize"}, 3)) spacing = {(*v)[0], (*v)[1], (*v)[2]};
+  if (auto v = MetaNumbers(fields, {"TransformMatrix", "Rotation", "Orientation"}, 9))
+    for (int axis = 0; axis < 3; ++axis)
+      for (int r = 0; r < 3; ++r) direction[3 * r + axis] = (*v)[3 * axis + r];
+  out.indexToWorld = IndexToWorld(origin, spacing, direction);
+}
+
+}  // namespace mmrtm

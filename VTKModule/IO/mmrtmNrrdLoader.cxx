@@ -1,0 +1,221 @@
+// NRRD volumes (.nrrd, .nhdr): vtkNrrdReader reads the voxels; the geometry
+// and the axis layout come from this file's own parse of the NRRD header.
+#include "mmrtmVolumeLoaderInternal.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkNrrdReader.h>
+
+namespace mmrtm {
+
+// vtkNrrdReader reads the voxels, but its geometry is not usable: it ignores
+// the direction of `space directions` (keeping only their lengths), leaves
+// `space origin` in the file's space, reverses the rows of raw-encoded files
+// in left-handed spaces (LAS), and takes a fastest axis of 9 or fewer samples
+// for vector components. So the geometry and the axis layout come from our
+// own parse of the header, and the voxels are put back in file order.
+
+namespace {
+
+struct NrrdHeader {
+  int dimension = 0;
+  std::vector<int64_t> sizes;
+  std::string space;     // lower-case, "" if absent
+  std::string encoding;  // lower-case, "raw" if absent
+  bool hasSpaceDirections = false;
+  std::vector<std::optional<Vec3d>> directions;  // per axis; nullopt = "none"
+  std::optional<Vec3d> origin;
+  std::vector<double> spacings;  // per axis, from the older `spacings` field
+};
+
+// "(a,b,c)" -> vector; "none" -> nullopt. Throws on anything else.
+std::optional<Vec3d> ParseNrrdVector(const std::string& token, const std::string& path) {
+  if (token == "none") return std::nullopt;
+  std::string inner = token;
+  if (inner.size() < 2 || inner.front() != '(' || inner.back() != ')')
+    throw InputError(path + ": bad NRRD vector '" + token + "'");
+  inner = inner.substr(1, inner.size() - 2);
+  std::replace(inner.begin(), inner.end(), ',', ' ');
+  const std::vector<double> v = ParseNumbers(inner);
+  if (v.size() != 3) throw InputError(path + ": NRRD vector '" + token + "' does not have 3 components");
+  return Vec3d{v[0], v[1], v[2]};
+}
+
+// Splits "(1,0,0) (0, 1, 0) none" into vector tokens, allowing spaces inside parentheses.
+std::vector<std::string> SplitNrrdVectors(const std::string& text) {
+  std::vector<std::string> tokens;
+  std::string current;
+  int depth = 0;
+  for (char c : text) {
+    if (c == '(') ++depth;
+    if (c == ')') --depth;
+    if (std::isspace((unsigned char)c) && depth == 0) {
+      if (!current.empty()) tokens.push_back(current);
+      current.clear();
+    } else if (!std::isspace((unsigned char)c)) {
+      current += c;
+    }
+  }
+  if (!current.empty()) tokens.push_back(current);
+  return tokens;
+}
+
+// Reads the header lines: up to the first blank line (a detached .nhdr header
+// is the whole file). Stops after 1 MiB so a file without a blank line is not
+// scanned as text to its end.
+std::vector<std::string> ReadNrrdHeaderLines(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  std::vector<std::string> lines;
+  std::string line;
+  size_t bytes = 0;
+  while (std::getline(in, line) && bytes < (1u << 20)) {
+    bytes += line.size() + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;
+    lines.push_back(line);
+  }
+  if (lines.empty() || lines[0].rfind("NRRD", 0) != 0) throw InputError(path + ": not a NRRD file (no NRRD magic)");
+  return lines;
+}
+
+NrrdHeader ParseNrrdHeader(const std::string& path) {
+  NrrdHeader h;
+  const std::vector<std::string> lines = ReadNrrdHeaderLines(path);
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::string& line = lines[i];
+    if (line[0] == '#') continue;
+    const size_t colon = line.find(": ");
+    if (colon == std::string::npos) continue;  // "key:=value" pairs and junk carry no geometry
+    const std::string field = Trim(line.substr(0, colon)), value = Trim(line.substr(colon + 2));
+    if (field == "dimension") {
+      h.dimension = std::atoi(value.c_str());
+    } else if (field == "sizes") {
+      for (double v : ParseNumbers(value)) {
+        if (!(v >= 1 && v <= std::numeric_limits<int>::max() && v == std::floor(v)))
+          throw InputError(path + ": NRRD 'sizes' must be positive integers: " + value);
+        h.sizes.push_back((int64_t)v);
+      }
+    } else if (field == "space") {
+      h.space = ToLower(value);
+    } else if (field == "encoding") {
+      h.encoding = ToLower(value);
+    } else if (field == "space directions") {
+      h.hasSpaceDirections = true;
+      for (const std::string& token : SplitNrrdVectors(value)) h.directions.push_back(ParseNrrdVector(token, path));
+    } else if (field == "space origin") {
+      h.origin = ParseNrrdVector(value, path);
+    } else if (field == "spacings") {
+      std::istringstream in(value);
+      std::string token;
+      while (in >> token) h.spacings.push_back(ToLower(token) == "nan" ? std::nan("") : std::atof(token.c_str()));
+    }
+  }
+  if (h.encoding.empty()) h.encoding = "raw";
+  if (h.dimension <= 0 || (int)h.sizes.size() != h.dimension)
+    throw InputError(path + ": NRRD header has no valid 'dimension' and 'sizes'");
+  if (h.hasSpaceDirections && (int)h.directions.size() != h.dimension)
+    throw InputError(path + ": NRRD 'space directions' has " + std::to_string(h.directions.size()) +
+                     " entries for " + std::to_string(h.dimension) + " axes");
+  return h;
+}
+
+// Per-axis signs that take coordinates of a NRRD space to LPS. Spaces
+// without anatomy (scanner-xyz, 3D-right-handed, ...) are taken as they are.
+Vec3d NrrdSpaceToLps(const std::string& space) {
+  if (space == "right-anterior-superior" || space == "ras") return {-1, -1, 1};
+  if (space == "left-anterior-superior" || space == "las") return {1, -1, 1};
+  return {1, 1, 1};
+}
+
+// The axes that are space, not vector components: those with a direction
+// when `space directions` is given; else all of them, except that a 4-axis
+// file's fastest axis is the components axis (vtkNrrdReader's assumption).
+std::vector<int> NrrdSpatialAxes(const NrrdHeader& h) {
+  std::vector<int> axes;
+  for (int a = 0; a < h.dimension; ++a) {
+    if (h.hasSpaceDirections ? h.directions[a].has_value() : !(h.dimension == 4 && a == 0)) axes.push_back(a);
+  }
+  return axes;
+}
+
+// Index -> LPS world from `space directions` and `space origin` (or the
+// older `spacings`, with an identity direction), for the spatial axes.
+Affine3 NrrdIndexToWorld(const NrrdHeader& h, const std::vector<int>& spatial, const std::string& path) {
+  const Vec3d toLps = NrrdSpaceToLps(h.space);
+  Vec3d origin{0, 0, 0}, spacing{1, 1, 1};
+  Mat3d direction = kIdentity3;
+  if (h.origin)
+    for (int r = 0; r < 3; ++r) origin[r] = (*h.origin)[r] * toLps[r];
+  for (int c = 0; c < (int)spatial.size(); ++c) {
+    const int axis = spatial[c];
+    if (h.hasSpaceDirections) {
+      const Vec3d& v = *h.directions[axis];
+      spacing[c] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      if (!(spacing[c] > 0) || !std::isfinite(spacing[c]))
+        throw InputError(path + ": NRRD space direction of axis " + std::to_string(axis) + " is zero or not finite");
+      for (int r = 0; r < 3; ++r) direction[3 * r + c] = v[r] * toLps[r] / spacing[c];
+    } else if (axis < (int)h.spacings.size() && std::isfinite(h.spacings[axis]) && h.spacings[axis] != 0) {
+      spacing[c] = h.spacings[axis];
+    }
+  }
+  // A 2D image's missing k axis: the plane normal, so the matrix stays invertible.
+  if (spatial.size() == 2 && h.hasSpaceDirections) {
+    const Vec3d n =
+        Cross(Vec3d{direction[0], direction[3], direction[6]}, Vec3d{direction[1], direction[4], direction[7]});
+    const double length = std::sqrt(Dot(n, n));
+    for (int r = 0; r < 3; ++r) direction[3 * r + 2] = length > 0 ? n[r] / length : kIdentity3[3 * r + 2];
+  }
+  return IndexToWorld(origin, spacing, direction);
+}
+
+}  // namespace
+
+void LoadNrrd(const std::string& path, HostVolume& out) {
+  const NrrdHeader h = ParseNrrdHeader(path);
+  const std::vector<int> spatial = NrrdSpatialAxes(h);
+  int64_t components = 1;
+  for (int a = 0; a < h.dimension; ++a)
+    if (std::find(spatial.begin(), spatial.end(), a) == spatial.end()) components *= h.sizes[a];
+  if (components != 1) ThrowComponents(path, components);
+  if (spatial.empty() || spatial.size() > 3)
+    throw InputError(path + ": a NRRD volume needs 1 to 3 spatial axes, this one has " +
+                     std::to_string(spatial.size()));
+
+  vtkNew<vtkNrrdReader> reader;
+  reader->SetFileName(path.c_str());
+  vtkImageData* image = RunReader(reader, path);
+  vtkDataArray* a = VoxelArray(image, path);
+
+  // The axis layout comes from our header; the buffer is the same whatever
+  // vtkNrrdReader made of the axes (x fastest either way).
+  for (int i = 0; i < 3; ++i) out.dims[i] = i < (int)spatial.size() ? (int)h.sizes[spatial[i]] : 1;
+  const int64_t values = (int64_t)a->GetNumberOfTuples() * a->GetNumberOfComponents();
+  if (values != out.VoxelCount())
+    throw InputError(path + ": holds " + std::to_string(values) + " voxels, expected " +
+                     std::to_string(out.VoxelCount()) + " (truncated or corrupt?)");
+  StoreVoxels(a->GetVoidPointer(0), SourceTypeOfVtk(a->GetDataType(), path), out.VoxelCount(), Rescale{}, out);
+  // vtkImageReader2 (raw encoding only) stores the rows of each slice bottom
+  // up when FileLowerLeft is off; undo that in the reader's own row layout,
+  // which may differ from ours when it took the x axis for components.
+  if (!reader->GetFileLowerLeft() && h.encoding == "raw") {
+    const int* vtkDims = image->GetDimensions();
+    ReverseRuns(out, (int64_t)vtkDims[0] * a->GetNumberOfComponents(), vtkDims[1]);
+  }
+
+  out.indexToWorld = NrrdIndexToWorld(h, spatial, path);
+}
+
+}  // namespace mmrtm

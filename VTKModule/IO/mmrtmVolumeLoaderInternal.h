@@ -1,0 +1,116 @@
+// PRIVATE to VTKModule/IO: what the volume loader's files share (helpers,
+// voxel conversion, VTK reader glue, one loader per format). Not installed and
+// not part of mmrtm_volume_io's interface: include it only from the .cxx files
+// in this folder. Everyone else uses mmrtmVolumeLoader.h. No VTK header here.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host_volume.h"
+
+class vtkAlgorithm;
+class vtkDataArray;
+class vtkImageData;
+
+namespace mmrtm {
+
+using Vec3d = std::array<double, 3>;
+using Mat3d = std::array<double, 9>;  // row-major; column c is the direction of index axis c
+
+inline constexpr Mat3d kIdentity3 = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+// ---------------------------------------------------------------------------
+// Small helpers (mmrtmLoaderUtilities.cxx)
+// ---------------------------------------------------------------------------
+
+std::string ToLower(std::string s);
+std::string Trim(const std::string& s);
+
+// Whitespace-separated numbers; stops at the first token that is not one.
+std::vector<double> ParseNumbers(const std::string& text);
+
+Vec3d Cross(const Vec3d& a, const Vec3d& b);
+double Dot(const Vec3d& a, const Vec3d& b);
+
+[[noreturn]] void ThrowComponents(const std::string& path, int64_t components);
+
+// ---------------------------------------------------------------------------
+// Voxel conversion (mmrtmLoaderUtilities.cxx)
+// ---------------------------------------------------------------------------
+
+// Voxel types as files store them, before the choice of a HostVolume type.
+enum class SourceType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
+
+// value = stored * slope + intercept (NIfTI scl_*, DICOM rescale).
+struct Rescale {
+  double slope = 1.0, intercept = 0.0;
+  bool IsIdentity() const { return slope == 1.0 && intercept == 0.0; }
+};
+
+// Stores `count` voxels of `type` into `out` (type and voxels), applying the
+// rescale and choosing the voxel type by the rules in mmrtmVolumeLoader.h.
+void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out);
+
+// Reverses, in place, the order of the runs of `runVoxels` voxels within each
+// block of `runsPerBlock` runs. With runs of one row (nx voxels) and blocks of
+// one slice this flips y; with runs of one slice and one block it flips z.
+void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock);
+
+// ---------------------------------------------------------------------------
+// VTK glue (mmrtmVtkReaderGlue.cxx)
+// ---------------------------------------------------------------------------
+
+// Watches a reader, its executive and the output window for errors while it
+// lives. The output window is process-wide: loading is meant for one thread.
+class ReaderErrors {
+ public:
+  explicit ReaderErrors(vtkAlgorithm* reader);
+  ~ReaderErrors();
+  ReaderErrors(const ReaderErrors&) = delete;
+  ReaderErrors& operator=(const ReaderErrors&) = delete;
+
+  // Throws InputError naming `path` if the reader reported an error.
+  void ThrowIfFailed(const std::string& path) const;
+
+ private:
+  struct Watch;  // the observers and the output window (VTK types): defined in the .cxx
+  std::unique_ptr<Watch> watch_;
+};
+
+// Runs a reader and returns its image, which the reader owns. Throws
+// InputError when the reader fails or produces no voxels.
+vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path);
+
+// The point-data array that holds the voxels: the active scalars, else the
+// only point array (VTI files need not mark their scalars active).
+vtkDataArray* VoxelArray(vtkImageData* image, const std::string& path);
+
+// The SourceType of a VTK scalar type (VTK_SHORT, ...); throws InputError
+// naming `path` for a type it cannot hold.
+SourceType SourceTypeOfVtk(int vtkType, const std::string& path);
+
+// Copies a single-component image's voxels into `out` (dims, type, voxels).
+void StoreImageVoxels(vtkImageData* image, const std::string& path, Rescale rescale, HostVolume& out);
+
+// x_world = origin + D * (spacing * index), with index 0 at the first stored
+// voxel.
+Affine3 VtkImageIndexToWorld(vtkImageData* image);
+
+// ---------------------------------------------------------------------------
+// One loader per format, each in its own file. Each fills `out`'s dims, type,
+// voxels and indexToWorld (LoadVolume sets the rest); bad input throws InputError.
+// ---------------------------------------------------------------------------
+
+void LoadNrrd(const std::string& path, HostVolume& out);         // mmrtmNrrdLoader.cxx
+void LoadNifti(const std::string& path, HostVolume& out);        // mmrtmNiftiLoader.cxx
+void LoadMetaImage(const std::string& path, HostVolume& out);    // mmrtmMetaImageLoader.cxx
+void LoadVti(const std::string& path, HostVolume& out);          // mmrtmVtkImageLoader.cxx
+void LoadLegacyVtk(const std::string& path, HostVolume& out);    // mmrtmVtkImageLoader.cxx
+void LoadDicomFolder(const std::string& folder, HostVolume& out);  // mmrtmDicomLoader.cxx
+void LoadInVesalius(const std::string& path, HostVolume& out);   // mmrtmInVesaliusLoader.cxx
+
+}  // namespace mmrtm
