@@ -5,14 +5,13 @@
 // With no INPUT it renders the head CT of Debian's invesalius-examples
 // package with the ct-bone preset. Progress goes to stderr, the image to the
 // named file; the exit code is 0 only on success. See --help.
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
-#include <map>
-#include <sstream>
 #include <string>
 
 #include <unistd.h>

@@ -141,8 +141,15 @@ TEST_P(Conservative, SingleLabelTimesCTOnTwoProxies) {
   Violations v = CheckAlongRandomRays(s, 1500, 1.f, 11);
   EXPECT_EQ(v.overMajorant, 0) << "of " << v.lookups << " lookups";
   EXPECT_EQ(v.inSkippedSpace, 0);
-  // Most of the volume holds no label 3: the grid must skip it.
+  // Most of the volume holds no label 3: most leaves must be empty, so that
+  // the traversal skips them.
   ASSERT_NE(scene.Grid(), nullptr);
+  const MajorantGridView& g = scene.Grid()->View();
+  const int64_t leaves = scene.Grid()->LeafCount();
+  int64_t nonEmpty = 0;
+  for (int64_t i = 0; i < leaves; ++i) nonEmpty += g.majorants[g.offset[g.leafLevel] + i] > 0.f;
+  EXPECT_GT(nonEmpty, 0);
+  EXPECT_LT(nonEmpty, leaves / 20) << nonEmpty << " of " << leaves << " leaves";
 }
 
 INSTANTIATE_TEST_SUITE_P(Accelerators, Conservative,

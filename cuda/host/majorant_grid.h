@@ -88,9 +88,6 @@ class MajorantGrid {
     int Bin(float v) const;
     void Range(int bin, float* lo, float* hi) const;  // a value range that contains the bin, with slack
   };
-  const BinMap& Bins(int proxy) const { return bins_[proxy]; }
-  // Leaf summary words of `proxy` (kSummaryWords per leaf, leaves x fastest).
-  const std::vector<uint64_t>& LeafSummaries(int proxy) const { return summaries_[proxy]; }
 
  private:
   void BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3], const int hi[3]);

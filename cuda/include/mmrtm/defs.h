@@ -12,7 +12,6 @@
 
 #if defined(__CUDACC__)
 #define MMRTM_CPU_GPU __host__ __device__
-#define MMRTM_GPU_ONLY __device__
 #else
 #define MMRTM_CPU_GPU
 #endif

@@ -106,8 +106,6 @@ class GridMajorantIterator {
     return false;
   }
 
-  int Level() const { return level_; }
-
  private:
   MMRTM_CPU_GPU void Climb() {
     --level_;

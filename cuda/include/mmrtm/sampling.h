@@ -13,7 +13,6 @@ MMRTM_CPU_GPU inline Vec3 SampleUniformSphere(float u0, float u1) {
   float phi = 2.f * kPi * u1;
   return {r * cosf(phi), r * sinf(phi), z};
 }
-MMRTM_CPU_GPU inline float UniformSpherePdf() { return kInv4Pi; }
 
 // Concentric mapping of the unit square to the unit disk (Shirley-Chiu).
 MMRTM_CPU_GPU inline void SampleUniformDiskConcentric(float u0, float u1, float* dx, float* dy) {

@@ -112,30 +112,6 @@ struct TransferFunctionView {
     return keys[i] >= lo && keys[i] <= hi;
   }
 
-  // Material TFs: whether some x in [lo, hi] maps to no material.
-  MMRTM_CPU_GPU bool MayMissInRange(float lo, float hi) const {
-    if (IsDiscreteTF(type)) {
-      // Missing unless every integer in [lo, hi] is a key.
-      for (float k = floorf(lo + 0.5f); k <= floorf(hi + 0.5f); k += 1.f)
-        if (FindEntry(k) < 0) return true;
-      return false;
-    }
-    // Ranges: covered if the union of ranges covers [lo, hi]; checked by
-    // walking the point forward through covering ranges.
-    float x = lo;
-    for (int pass = 0; pass < count; ++pass) {
-      bool advanced = false;
-      for (int i = 0; i < count; ++i)
-        if (x >= keys[2 * i] && x < keys[2 * i + 1]) {
-          x = keys[2 * i + 1];
-          advanced = true;
-        }
-      if (x > hi) return false;
-      if (!advanced) return true;
-    }
-    return x <= hi;
-  }
-
  private:
   MMRTM_CPU_GPU void Copy(int i, float* out) const {
     for (int c = 0; c < channels; ++c) out[c] = values[i * channels + c];

@@ -24,7 +24,6 @@ struct Vec3 {
 
 MMRTM_CPU_GPU inline Vec3 operator*(float s, Vec3 v) { return v * s; }
 MMRTM_CPU_GPU inline float Dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-MMRTM_CPU_GPU inline float AbsDot(Vec3 a, Vec3 b) { return fabsf(Dot(a, b)); }
 MMRTM_CPU_GPU inline Vec3 Cross(Vec3 a, Vec3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
@@ -53,7 +52,6 @@ struct RGB {
   MMRTM_CPU_GPU RGB& operator*=(float s) { r *= s; g *= s; b *= s; return *this; }
 
   MMRTM_CPU_GPU float MaxComponent() const { return Max(r, Max(g, b)); }
-  MMRTM_CPU_GPU float Average() const { return (r + g + b) * (1.f / 3.f); }
   MMRTM_CPU_GPU bool IsBlack() const { return r == 0.f && g == 0.f && b == 0.f; }
 };
 
