@@ -6,6 +6,7 @@ packages=(
   build-essential cmake git pkg-config
   nlohmann-json3-dev libpng-dev zlib1g-dev libgtest-dev
   libvtk9-dev python3-vtk9
+  libinsighttoolkit5-dev   # DICOM through ITK + GDCM (JPEG 2000 included)
   xvfb xauth
   invesalius-examples   # the default input: Cranium.inv3
 )

@@ -38,7 +38,14 @@ options:
   --scene FILE.json     scene file (Documentation/scene-format.md); applied over the preset
   --preset NAME         scene preset from %s
                         (default: ct-bone when no --scene is given)
-  --labels FILE         label map, the proxy named "labels" (nearest lookup)
+  --series ID           DICOM folder with several series: the SeriesInstanceUID or
+                        SeriesDescription of the one to read (default: the largest)
+  --list-series         list the series of the DICOM folder INPUT and exit
+  --labels FILE         label map, the proxy named "labels" (nearest lookup); put on
+                        INPUT's grid (nearest neighbour) when its grid differs
+  --label-table FILE    label names and colours: "id name [r g b [a]]" lines, or a
+                        3D Slicer colour table (.ctbl/.txt); used by presets with
+                        "label_materials" (ct-organs), which make a material per label
   --width W             image width in pixels (default: scene, else 512)
   --height H            image height in pixels (default: scene, else 512)
   --spp N               samples per pixel (default: scene, else 64)
@@ -61,9 +68,9 @@ options:
 )";
 
 struct Options {
-  std::string input, scene, preset, labels, output = "mmrtm-render.png", outputLinear, statsJson;
+  std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear, statsJson;
   json render = json::object();  // overrides of the scene's "render" block
-  bool quiet = false;
+  bool quiet = false, listSeries = false;
 };
 
 [[noreturn]] void UsageError(const std::string& msg) {
@@ -107,6 +114,9 @@ Options ParseArguments(int argc, char** argv) {
     } else if (a == "--scene") o.scene = value();
     else if (a == "--preset") o.preset = value();
     else if (a == "--labels") o.labels = value();
+    else if (a == "--label-table") o.labelTable = value();
+    else if (a == "--series") o.series = value();
+    else if (a == "--list-series") o.listSeries = true;
     else if (a == "--width") o.render["width"] = ParseInteger(a, value(), 1, 16384);
     else if (a == "--height") o.render["height"] = ParseInteger(a, value(), 1, 16384);
     else if (a == "--spp") o.render["spp"] = ParseInteger(a, value(), 1, 1 << 24);
@@ -179,7 +189,16 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+int ListSeries(const Options& o) {
+  if (o.input.empty()) throw mmrtm::InputError("--list-series needs a DICOM folder as INPUT");
+  for (const mmrtm::DicomSeriesSummary& s : mmrtm::ListDicomSeries(o.input))
+    std::printf("%s\t%d slices\t%d x %d\t%s\t%s\n", s.uid.c_str(), s.slices, s.columns, s.rows, s.modality.c_str(),
+                s.description.c_str());
+  return 0;
+}
+
 int Run(const Options& o) {
+  if (o.listSeries) return ListSeries(o);
   const auto tStart = std::chrono::steady_clock::now();
   CheckWritable(o.output);
   CheckWritable(o.outputLinear);
@@ -206,7 +225,17 @@ int Run(const Options& o) {
   const std::string input = !o.input.empty() ? o.input : (sceneHasScalars ? "" : mmrtm::DefaultVolumePath());
   if (!input.empty()) {
     if (!o.quiet) std::fprintf(stderr, "Loading %s\n", input.c_str());
-    inputs.volumes["scalars"] = mmrtm::LoadVolume(input, "scalars");
+    mmrtm::VolumeLoadOptions load;
+    load.series = o.series;
+    inputs.volumes["scalars"] = mmrtm::LoadVolume(input, "scalars", load);
+  } else if (!o.series.empty()) {
+    throw mmrtm::InputError("--series needs a DICOM folder as INPUT");
+  }
+  if (!o.labelTable.empty()) {
+    if (!doc.contains("label_materials"))
+      std::fprintf(stderr, "warning: --label-table %s is not used: the scene has no \"label_materials\" (try --preset ct-organs)\n",
+                   o.labelTable.c_str());
+    inputs.labelTable = mmrtm::ReadLabelTable(o.labelTable);
   }
   if (!o.labels.empty()) {
     if (!o.quiet) std::fprintf(stderr, "Loading labels %s\n", o.labels.c_str());

@@ -1,5 +1,6 @@
-// Image test: a real head CT from ../shared/data with the ct-bone preset,
-// against a baseline that was looked at (Data/Baselines/ct_head_cranium_bone.png).
+// Image tests: real CTs from ../shared/data with the ct-bone preset, against
+// baselines that were looked at (Data/Baselines/*.png): the head CT, and the
+// chest DICOM series in its own orientation (read through the DICOM loader).
 //
 // The baseline keeps each pixel's mean and the variance of that mean (PFM),
 // so the comparison is statistical: the difference of two Monte Carlo images
@@ -31,15 +32,15 @@ struct Rendered {
   float meanAlpha = 0;
 };
 
-Rendered RenderCranium(uint64_t seed, float albedoScale = 1.f) {
+// The ct-bone preset on `volume` (a file or folder in ../shared/data), 128 x 128.
+Rendered RenderBonePreset(const std::string& volume, const nlohmann::json& camera, uint64_t seed,
+                          float albedoScale = 1.f) {
   nlohmann::json doc = ReadJsonFile(std::string(MMRTM_DATA_DIR) + "/presets/ct-bone.json");
   doc["render"].merge_patch({{"width", 128}, {"height", 128}, {"spp", 32}, {"seed", seed}});
   for (auto& c : doc["materials"]["bone"]["albedo"]) c = c.get<float>() * albedoScale;
-  // This NRRD keeps InVesalius's row order with an identity direction, so its
-  // face is at +y: look from there.
-  doc["camera"]["azimuth"] = 205;
+  doc["camera"].merge_patch(camera);
   SceneInputs inputs;
-  inputs.volumes["scalars"] = LoadVolume(std::string(MMRTM_SHARED_DATA_DIR) + "/ct_head_cranium.nrrd");
+  inputs.volumes["scalars"] = LoadVolume(std::string(MMRTM_SHARED_DATA_DIR) + "/" + volume);
   Scene scene = SceneFromJson(doc, std::move(inputs));
   SceneView view = scene.Build();
   Film film(scene.render.width, scene.render.height);
@@ -89,11 +90,19 @@ Comparison Compare(const Rendered& a, const RGBImage& baseMean, const RGBImage& 
   return c;
 }
 
+// This NRRD keeps InVesalius's row order with an identity direction, so its
+// face is at +y: look from there.
+Rendered RenderCranium(uint64_t seed, float albedoScale = 1.f) {
+  return RenderBonePreset("ct_head_cranium.nrrd", {{"azimuth", 205}}, seed, albedoScale);
+}
+
 const std::string kBaseline = std::string(MMRTM_DATA_DIR) + "/Baselines/ct_head_cranium_bone";
 
-TEST(ImageCT, HeadBonePresetMatchesBaseline) {
-  Rendered r = RenderCranium(1);
-  const std::string out = std::string(MMRTM_TEST_OUTPUT_DIR) + "/ct_head_cranium_bone.png";
+// Renders, checks the image is neither black nor blown out, and compares it
+// with the baseline `name` (or rewrites it with MMRTM_UPDATE_BASELINES=1).
+void ExpectMatchesBaseline(const Rendered& r, const std::string& name) {
+  const std::string baseline = std::string(MMRTM_DATA_DIR) + "/Baselines/" + name;
+  const std::string out = std::string(MMRTM_TEST_OUTPUT_DIR) + "/" + name + ".png";
   WritePNG(out, r.mean.width, r.mean.height, 3, r.png);
 
   // Not a black or blown-out image: the skull covers part of the frame, and
@@ -106,17 +115,26 @@ TEST(ImageCT, HeadBonePresetMatchesBaseline) {
   EXPECT_LT(lum, 0.9) << out;
 
   if (std::getenv("MMRTM_UPDATE_BASELINES")) {
-    WritePFM(kBaseline + ".pfm", r.mean);
-    WritePFM(kBaseline + "_variance.pfm", r.variance);
-    WritePNG(kBaseline + ".png", r.mean.width, r.mean.height, 3, r.png);
-    GTEST_SKIP() << "baseline rewritten: look at " << kBaseline << ".png before committing it";
+    WritePFM(baseline + ".pfm", r.mean);
+    WritePFM(baseline + "_variance.pfm", r.variance);
+    WritePNG(baseline + ".png", r.mean.width, r.mean.height, 3, r.png);
+    GTEST_SKIP() << "baseline rewritten: look at " << baseline << ".png before committing it";
   }
-  const RGBImage baseMean = ReadPFM(kBaseline + ".pfm"), baseVar = ReadPFM(kBaseline + "_variance.pfm");
+  const RGBImage baseMean = ReadPFM(baseline + ".pfm"), baseVar = ReadPFM(baseline + "_variance.pfm");
   ASSERT_EQ(baseMean.width, r.mean.width);
   ASSERT_EQ(baseMean.height, r.mean.height);
   Comparison c = Compare(r, baseMean, baseVar);
   EXPECT_LT(c.meanZ2, 1.5) << "the image differs from the baseline beyond its noise; see " << out;
   EXPECT_LT(c.fractionOver4, 0.01) << "see " << out;
+}
+
+TEST(ImageCT, HeadBonePresetMatchesBaseline) { ExpectMatchesBaseline(RenderCranium(1), "ct_head_cranium_bone"); }
+
+// The chest series through the DICOM loader, seen from the front (the preset's
+// default camera, anterior in LPS): a wrong row order, slice order or
+// orientation turns or mirrors the ribcage and fails the comparison.
+TEST(ImageCT, ChestDicomSeriesMatchesBaseline) {
+  ExpectMatchesBaseline(RenderBonePreset("ct_chest_dicom", nlohmann::json::object(), 1), "ct_chest_dicom_bone");
 }
 
 // The comparison is not vacuous: another seed passes, a 25% darker bone does not.

@@ -71,6 +71,9 @@ class RenderCli(unittest.TestCase):
             "ct-angio-labels": [os.path.join(DATA, "cta_chest_aorta.nii.gz"), "--labels",
                                 os.path.join(DATA, "cta_chest_aorta_labels.nii.gz")],
             "mri": [os.path.join(DATA, "mr_head.nii.gz")],
+            "ct-organs": [os.path.join(DATA, "ct_abdomen.nii.gz"), "--labels",
+                          os.path.join(DATA, "ct_abdomen_labels.nii.gz"), "--label-table",
+                          os.path.join(DATA, "ct_abdomen_labels.txt")],
         }
         presets = sorted(f[:-5] for f in os.listdir(os.path.join(os.path.dirname(__file__), "..", "..", "Data",
                                                                  "presets")) if f.endswith(".json"))
@@ -99,6 +102,38 @@ class RenderCli(unittest.TestCase):
             lookups[accelerator] = s["density_lookups_per_real_collision"]
         self.assertLess(lookups["octree"], lookups["none"] / 2, lookups)
         self.assertLess(lookups["macrocell"], lookups["none"] / 2, lookups)
+
+    def test_dicom_folder_and_series(self):
+        chest = os.path.join(DATA, "ct_chest_dicom")
+        r = subprocess.run([RENDER, chest, "--list-series"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        uid = r.stdout.split("\t")[0]
+        self.assertIn("92 slices", r.stdout)
+        r = self.run_render(chest, "--series", uid, "--width", "24", "--height", "24", "--spp", "1")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        os.remove(self.png)
+        self.expect_failure(self.run_render(chest, "--series", "1.2.3"), "ct_chest_dicom",
+                            "no series with the UID or description \"1.2.3\"", uid)
+
+    def test_label_table_errors(self):
+        ct = os.path.join(DATA, "ct_abdomen.nii.gz")
+        labels = os.path.join(DATA, "ct_abdomen_labels.nii.gz")
+        self.expect_failure(self.run_render(ct, "--labels", labels, "--preset", "ct-organs", "--label-table",
+                                            os.path.join(self.dir, "none.txt")), "none.txt")
+        table = self.write("bad.txt", "1 liver 255 0 0\n1 spleen\n")
+        self.expect_failure(self.run_render(ct, "--labels", labels, "--preset", "ct-organs", "--label-table", table),
+                            "bad.txt:2")
+        self.expect_failure(self.run_render(ct, "--preset", "ct-organs"), "label_materials", "--labels")
+
+    def test_labels_that_miss_the_volume(self):
+        # The label map shifted 10 m away in its header: nothing to align.
+        far = self.write("far.nrrd", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+                                     "space: left-posterior-superior\nspace origin: (10000,0,0)\n"
+                                     "space directions: (1,0,0) (0,1,0) (0,0,1)\n\n")
+        with open(far, "ab") as f:
+            f.write(bytes([0, 1, 1, 1, 1, 1, 1, 1]))
+        self.expect_failure(self.run_render(os.path.join(DATA, "cta_chest_aorta.nii.gz"), "--labels", far,
+                                            "--preset", "ct-angio-labels"), "far.nrrd", "overlap")
 
     def test_missing_input(self):
         self.expect_failure(self.run_render(os.path.join(self.dir, "nope.nrrd")), "nope.nrrd")
@@ -155,7 +190,7 @@ class RenderCli(unittest.TestCase):
     def test_help_lists_every_option(self):
         r = subprocess.run([RENDER, "--help"], capture_output=True, text=True, timeout=60)
         self.assertEqual(r.returncode, 0)
-        for option in ["--scene", "--preset", "--labels", "--width", "--height", "--spp", "--seed", "--threads",
+        for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--width", "--height", "--spp", "--seed", "--threads",
                        "--estimator", "--output", "--output-linear", "--stats-json"]:
             self.assertIn(option, r.stdout)
 

@@ -1,4 +1,5 @@
-// DICOM series (a folder of uncompressed slice files) through
+// DICOM series without ITK (MMRTM_ENABLE_ITK off; mmrtmItkDicomLoader.cxx is
+// the full reader): a folder of uncompressed slice files through
 // vtkDICOMImageReader, after checks it does not make itself; voxels stored in
 // DICOM order, geometry from ImagePositionPatient and ImageOrientationPatient.
 #include "mmrtmVolumeLoaderInternal.h"
@@ -200,7 +201,9 @@ Vec3d DicomSliceStep(const std::string& folder, const std::vector<DicomSliceHead
 
 }  // namespace
 
-void LoadDicomFolder(const std::string& folder, HostVolume& out) {
+void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoadOptions& options) {
+  if (!options.series.empty())
+    throw InputError(folder + ": choosing a series needs the ITK/GDCM reader, which is not built (MMRTM_ENABLE_ITK)");
   const std::vector<std::string> files = ListFiles(folder);
   if (files.empty())
     throw InputError(folder + ": the folder holds no files (expected the DICOM files of one series)");
@@ -255,6 +258,10 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out) {
     direction[3 * r + 2] = step[r] / dz;
   }
   out.indexToWorld = IndexToWorld(origin, {dx, dy, dz}, direction);
+}
+
+std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder) {
+  throw InputError(folder + ": listing DICOM series needs the ITK/GDCM reader, which is not built (MMRTM_ENABLE_ITK)");
 }
 
 }  // namespace mmrtm

@@ -316,7 +316,7 @@ std::pair<SourceType, int> NumpyType(const std::string& dtype, const std::string
 
 }  // namespace
 
-void LoadInVesalius(const std::string& path, HostVolume& out) {
+void LoadInVesalius(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/) {
   const std::vector<uint8_t> plistBytes = ReadTarMember(path, "main.plist", 16u << 20, false);
   const std::string where = path + ": main.plist";
   const PlistValue root = PlistParser(std::string(plistBytes.begin(), plistBytes.end()), where).ParseDocument();
@@ -334,6 +334,7 @@ void LoadInVesalius(const std::string& path, HostVolume& out) {
     out.dims[a] = (int)n;
   }
   const uint64_t bytes = (uint64_t)out.VoxelCount() * (uint64_t)typeSize;
+  CheckMemoryAvailable(path, 2.0 * (double)bytes, "the voxel matrix");
   const std::vector<uint8_t> raw = ReadTarMember(path, fs::path(dataName).filename().string(), bytes, true);
   if (raw.size() != bytes)
     throw InputError(path + ": " + dataName + " holds " + std::to_string(raw.size()) + " bytes, expected " +

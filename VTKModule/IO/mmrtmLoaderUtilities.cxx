@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -122,8 +124,10 @@ void ConvertValues(const In* in, int64_t n, Rescale r, uint8_t* outBytes) {
 
 }  // namespace
 
-void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out) {
-  if (const auto native = NativeVoxelType(type); native && rescale.IsIdentity()) {
+void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out,
+                 bool narrowFloats) {
+  if (const auto native = NativeVoxelType(type); native && rescale.IsIdentity() &&
+                                                 !(narrowFloats && type == SourceType::Float32)) {
     out.type = *native;
     const auto* bytes = static_cast<const uint8_t*>(data);
     out.voxels.assign(bytes, bytes + count * VoxelTypeSize(*native));
@@ -132,7 +136,7 @@ void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale resca
   // float32 stays float32 after a rescale; every other type may become an
   // integer type when its (rescaled) values allow it.
   VoxelType target = VoxelType::Float32;
-  if (type != SourceType::Float32)
+  if (type != SourceType::Float32 || narrowFloats)
     WithTypedPointer(type, data, [&](auto* p) { target = SmallestExactType(ScanValues(p, count, rescale)); });
   out.type = target;
   out.voxels.resize((size_t)(count * VoxelTypeSize(target)));
@@ -153,6 +157,52 @@ void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock) {
     for (int64_t lo = 0, hi = runsPerBlock - 1; lo < hi; ++lo, --hi)
       std::swap_ranges(v.voxels.begin() + b + lo * run, v.voxels.begin() + b + (lo + 1) * run,
                        v.voxels.begin() + b + hi * run);
+}
+
+// ---------------------------------------------------------------------------
+// Memory and warnings
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// MemAvailable from /proc/meminfo (what can be allocated without swapping);
+// 0 if unknown.
+double AvailableMemoryBytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kib = 0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024.0;
+  return 0.0;
+}
+
+std::string HumanBytes(double bytes) {
+  const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  int u = 0;
+  while (bytes >= 1024.0 && u < 6) {
+    bytes /= 1024.0;
+    ++u;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, u == 0 ? "%.0f %s" : "%.1f %s", bytes, units[u]);
+  return text;
+}
+
+}  // namespace
+
+void CheckMemoryAvailable(const std::string& path, double bytes, const std::string& what) {
+  const double available = AvailableMemoryBytes();
+  if (available > 0 && bytes > available)
+    throw InputError(path + ": " + what + " needs " + HumanBytes(bytes) + " but this machine has " +
+                     HumanBytes(available) + " of memory available; nothing was allocated");
+}
+
+void Warn(const VolumeLoadOptions& options, const std::string& message) {
+  if (options.warn)
+    options.warn(message);
+  else
+    std::fprintf(stderr, "warning: %s\n", message.c_str());
 }
 
 }  // namespace mmrtm

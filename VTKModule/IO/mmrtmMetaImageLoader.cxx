@@ -5,6 +5,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -54,8 +55,10 @@ MetaImageHeader ReadMetaImageHeader(const std::string& path) {
 }
 
 // The number of bytes the zlib (or gzip) stream at `offset` of `file`
-// inflates to. Throws if the stream is damaged or cut short.
-uint64_t InflatedSize(const std::string& file, uint64_t offset, const std::string& where) {
+// inflates to; the first `capacity` of them go to `dst` when it is not null.
+// Throws if the stream is damaged or cut short.
+uint64_t Inflate(const std::string& file, uint64_t offset, const std::string& where, uint8_t* dst = nullptr,
+                 uint64_t capacity = 0) {
   std::ifstream in(file, std::ios::binary);
   if (!in.seekg((std::streamoff)offset)) throw InputError(where + ": cannot read " + file);
   z_stream zs{};
@@ -74,7 +77,9 @@ uint64_t InflatedSize(const std::string& file, uint64_t offset, const std::strin
     zs.avail_out = (uInt)output.size();
     ret = inflate(&zs, Z_NO_FLUSH);
     if (ret != Z_OK && ret != Z_STREAM_END && ret != Z_BUF_ERROR) break;
-    total += output.size() - zs.avail_out;
+    const uint64_t produced = output.size() - zs.avail_out;
+    if (dst && total < capacity) std::copy_n(output.data(), std::min(produced, capacity - total), dst + total);
+    total += produced;
   }
   inflateEnd(&zs);
   if (ret != Z_STREAM_END)
@@ -84,9 +89,11 @@ uint64_t InflatedSize(const std::string& file, uint64_t offset, const std::strin
 }
 
 // metaio reports a short or damaged data file only on the console and
-// returns what it read, so check that all `bytes` of voxel data are there.
-// Data split over several files (LIST, patterns) is left to the reader.
-void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint64_t bytes) {
+// returns what it read, so check that all `bytes` of voxel data (the
+// reader's buffer `voxels`) are there. Data split over several files (LIST,
+// patterns) is left to the reader.
+void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint8_t* voxels, uint64_t bytes,
+                        int valueSize, const VolumeLoadOptions& options) {
   auto field = [&](const char* key) {
     auto it = h.fields.find(key);
     return it == h.fields.end() ? std::string() : it->second;
@@ -102,8 +109,26 @@ void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint6
   const uint64_t fileSize = fs::file_size(dataFile, ec);
   if (ec) throw InputError(path + ": cannot open its data file " + dataName);
   const bool compressed = ToLower(field("CompressedData")) == "true";
+  // A wrong CompressedDataSize (the Whole Frog header said 260020 for a
+  // 262087-byte stream) makes metaio, in VTK as in ITK, stop early and leave
+  // garbage in the last slices: inflate the whole stream here instead.
+  const std::string declared = field("CompressedDataSize");
+  if (compressed && !declared.empty() && dataName != "LOCAL" && headerSize == 0 &&
+      std::strtoull(declared.c_str(), nullptr, 10) != fileSize) {
+    const uint64_t inflated = Inflate(dataFile, offset, path, voxels, bytes);
+    if (inflated < bytes)
+      throw InputError(path + ": voxel data is " + std::to_string(inflated) + " bytes, expected " +
+                       std::to_string(bytes) + " (truncated?)");
+    const std::string msb = ToLower(field("BinaryDataByteOrderMSB") + field("ElementByteOrderMSB"));
+    if (msb.find("true") != std::string::npos && valueSize > 1)  // stored big endian; this machine is little endian
+      for (uint64_t i = 0; i + valueSize <= bytes; i += valueSize) std::reverse(voxels + i, voxels + i + valueSize);
+    Warn(options, path + ": CompressedDataSize says " + declared + " bytes but " + dataName + " holds " +
+                      std::to_string(fileSize) + "; the header is wrong (readers that trust it stop early and " +
+                      "leave garbage), so the whole stream was inflated and checked");
+    return;
+  }
   const uint64_t available =
-      compressed ? InflatedSize(dataFile, offset, path) : (fileSize > offset ? fileSize - offset : 0);
+      compressed ? Inflate(dataFile, offset, path) : (fileSize > offset ? fileSize - offset : 0);
   if (available < bytes)
     throw InputError(path + ": voxel data is " + std::to_string(available) + " bytes, expected " +
                      std::to_string(bytes) + " (truncated?)");
@@ -123,7 +148,7 @@ std::optional<std::vector<double>> MetaNumbers(const std::map<std::string, std::
 
 }  // namespace
 
-void LoadMetaImage(const std::string& path, HostVolume& out) {
+void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOptions& options) {
   const MetaImageHeader header = ReadMetaImageHeader(path);
   const auto& fields = header.fields;
   if (fields.find("ObjectType") == fields.end() && fields.find("NDims") == fields.end())
@@ -132,7 +157,8 @@ void LoadMetaImage(const std::string& path, HostVolume& out) {
   reader->SetFileName(path.c_str());
   vtkImageData* image = RunReader(reader, path);
   vtkDataArray* a = VoxelArray(image, path);
-  CheckMetaImageData(path, header, (uint64_t)a->GetNumberOfValues() * (uint64_t)a->GetDataTypeSize());
+  CheckMetaImageData(path, header, static_cast<uint8_t*>(a->GetVoidPointer(0)),
+                     (uint64_t)a->GetNumberOfValues() * (uint64_t)a->GetDataTypeSize(), a->GetDataTypeSize(), options);
   StoreImageVoxels(image, path, Rescale{}, out);
 
   // 2D images (NDims 2) keep VTK's origin and spacing, with an identity direction.

@@ -46,7 +46,7 @@ Affine3 NiftiIndexToWorld(vtkNIFTIImageReader* reader, vtkImageData* image) {
 
 }  // namespace
 
-void LoadNifti(const std::string& path, HostVolume& out) {
+void LoadNifti(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/) {
   vtkNew<vtkNIFTIImageReader> reader;
   reader->SetFileName(path.c_str());
   vtkImageData* image = RunReader(reader, path);

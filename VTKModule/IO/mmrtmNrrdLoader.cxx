@@ -183,7 +183,7 @@ Affine3 NrrdIndexToWorld(const NrrdHeader& h, const std::vector<int>& spatial, c
 
 }  // namespace
 
-void LoadNrrd(const std::string& path, HostVolume& out) {
+void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/) {
   const NrrdHeader h = ParseNrrdHeader(path);
   const std::vector<int> spatial = NrrdSpatialAxes(h);
   int64_t components = 1;

@@ -27,7 +27,7 @@ std::string VolumeExtension(const std::string& path) {
   return fs::path(file).extension().string();
 }
 
-using FileLoader = void (*)(const std::string&, HostVolume&);
+using FileLoader = void (*)(const std::string&, HostVolume&, const VolumeLoadOptions&);
 
 struct FormatEntry {
   const char* extension;
@@ -40,10 +40,10 @@ constexpr FormatEntry kFormats[] = {
     {".inv3", LoadInVesalius},
 };
 
-void LoadVolumeFile(const std::string& path, HostVolume& out) {
+void LoadVolumeFile(const std::string& path, HostVolume& out, const VolumeLoadOptions& options) {
   const std::string ext = VolumeExtension(path);
   for (const FormatEntry& f : kFormats)
-    if (ext == f.extension) return f.load(path, out);
+    if (ext == f.extension) return f.load(path, out, options);
   std::string known;
   for (const FormatEntry& f : kFormats) known += std::string(known.empty() ? "" : " ") + f.extension;
   throw InputError(path + ": unknown volume format '" + ext + "' (known: " + known + ", or a DICOM folder)");
@@ -52,6 +52,12 @@ void LoadVolumeFile(const std::string& path, HostVolume& out) {
 }  // namespace
 
 HostVolume LoadVolume(const std::string& path, const std::string& name, Interpolation interpolation) {
+  VolumeLoadOptions options;
+  options.interpolation = interpolation;
+  return LoadVolume(path, name, options);
+}
+
+HostVolume LoadVolume(const std::string& path, const std::string& name, const VolumeLoadOptions& options) {
   if (path.empty()) throw InputError("no volume path given");
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
@@ -60,12 +66,12 @@ HostVolume LoadVolume(const std::string& path, const std::string& name, Interpol
   HostVolume volume;
   volume.name = name;
   volume.source = path;
-  volume.interpolation = interpolation;
+  volume.interpolation = options.interpolation;
   try {
     if (fs::is_directory(status))
-      LoadDicomFolder(path, volume);
+      LoadDicomFolder(path, volume, options);
     else
-      LoadVolumeFile(path, volume);
+      LoadVolumeFile(path, volume, options);
   } catch (const InputError&) {
     throw;
   } catch (const std::bad_alloc&) {

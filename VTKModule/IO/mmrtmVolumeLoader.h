@@ -6,7 +6,9 @@
 // world. VTK is used behind this interface only: no VTK header here.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "host_volume.h"
 
@@ -21,7 +23,15 @@ namespace mmrtm {
 //   .vti             VTK XML image data (origin, spacing, direction)
 //   .vtk             VTK legacy STRUCTURED_POINTS (origin, spacing)
 //   .inv3            InVesalius project (identity orientation, origin 0)
-//   a folder         DICOM series (uncompressed transfer syntaxes only)
+//   a folder         DICOM series, through ITK/GDCM (every transfer syntax
+//                    GDCM decodes, JPEG 2000 included); without ITK
+//                    (MMRTM_ENABLE_ITK off) vtkDICOMImageReader, uncompressed only
+//
+// DICOM (Documentation/dicom.md): the largest series in the folder is read
+// unless VolumeLoadOptions::series names one; rescale slope/intercept are
+// applied (Hounsfield units for CT); orientation and origin go into
+// indexToWorld; a gantry tilt is kept as a shear of the grid; slices spaced
+// unevenly (a missing slice) are resampled onto a regular grid, with a warning.
 //
 // Voxel types: uint8, int16, uint16 and float32 are kept as they are. Other
 // types, and volumes with a rescale slope/intercept, become the smallest of
@@ -34,6 +44,29 @@ namespace mmrtm {
 // voxels and folders without readable DICOM files.
 HostVolume LoadVolume(const std::string& path, const std::string& name = "scalars",
                       Interpolation interpolation = Interpolation::Trilinear);
+
+struct VolumeLoadOptions {
+  Interpolation interpolation = Interpolation::Trilinear;
+  // DICOM folders: the SeriesInstanceUID or the SeriesDescription of the
+  // series to read; empty reads the series with the most slices.
+  std::string series;
+  // Receives each warning (one line, naming the file); null prints them to
+  // stderr as "warning: ...".
+  std::function<void(const std::string&)> warn;
+};
+
+HostVolume LoadVolume(const std::string& path, const std::string& name, const VolumeLoadOptions& options);
+
+// One DICOM series of a folder, as ListDicomSeries reports it.
+struct DicomSeriesSummary {
+  std::string uid, description, modality;
+  int slices = 0;
+  int rows = 0, columns = 0;
+};
+
+// The image series of a DICOM folder, most slices first. Throws InputError
+// for a missing folder or one with no DICOM image file.
+std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder);
 
 // The default input: InVesalius's Cranium.inv3 from Debian's
 // invesalius-examples package.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "host_volume.h"
+#include "mmrtmVolumeLoader.h"
 
 class vtkAlgorithm;
 class vtkDataArray;
@@ -53,7 +54,18 @@ struct Rescale {
 
 // Stores `count` voxels of `type` into `out` (type and voxels), applying the
 // rescale and choosing the voxel type by the rules in mmrtmVolumeLoader.h.
-void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out);
+// With narrowFloats, float32 voxels that are all integers (a DICOM slice read
+// as float) also take the smallest exact integer type.
+void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out,
+                 bool narrowFloats = false);
+
+// Throws InputError naming `path` when `bytes` (the voxels about to be
+// allocated, described by `what`) exceed the memory this machine has
+// available, before anything is allocated.
+void CheckMemoryAvailable(const std::string& path, double bytes, const std::string& what);
+
+// Sends a warning to options.warn, or to stderr.
+void Warn(const VolumeLoadOptions& options, const std::string& message);
 
 // Reverses, in place, the order of the runs of `runVoxels` voxels within each
 // block of `runsPerBlock` runs. With runs of one row (nx voxels) and blocks of
@@ -105,12 +117,13 @@ Affine3 VtkImageIndexToWorld(vtkImageData* image);
 // voxels and indexToWorld (LoadVolume sets the rest); bad input throws InputError.
 // ---------------------------------------------------------------------------
 
-void LoadNrrd(const std::string& path, HostVolume& out);         // mmrtmNrrdLoader.cxx
-void LoadNifti(const std::string& path, HostVolume& out);        // mmrtmNiftiLoader.cxx
-void LoadMetaImage(const std::string& path, HostVolume& out);    // mmrtmMetaImageLoader.cxx
-void LoadVti(const std::string& path, HostVolume& out);          // mmrtmVtkImageLoader.cxx
-void LoadLegacyVtk(const std::string& path, HostVolume& out);    // mmrtmVtkImageLoader.cxx
-void LoadDicomFolder(const std::string& folder, HostVolume& out);  // mmrtmDicomLoader.cxx
-void LoadInVesalius(const std::string& path, HostVolume& out);   // mmrtmInVesaliusLoader.cxx
+void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);         // mmrtmNrrdLoader.cxx
+void LoadNifti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);        // mmrtmNiftiLoader.cxx
+void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);    // mmrtmMetaImageLoader.cxx
+void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);          // mmrtmVtkImageLoader.cxx
+void LoadLegacyVtk(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);    // mmrtmVtkImageLoader.cxx
+// mmrtmItkDicomLoader.cxx with ITK, else mmrtmDicomLoader.cxx (VTK)
+void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoadOptions& options);
+void LoadInVesalius(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);   // mmrtmInVesaliusLoader.cxx
 
 }  // namespace mmrtm

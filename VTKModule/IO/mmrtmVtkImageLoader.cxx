@@ -13,7 +13,7 @@ namespace mmrtm {
 // Scientific data without anatomy: the coordinates are taken as LPS as they
 // are. VTI files may carry a Direction matrix, which vtkImageData keeps.
 
-void LoadVti(const std::string& path, HostVolume& out) {
+void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/) {
   vtkNew<vtkXMLImageDataReader> reader;
   if (!reader->CanReadFile(path.c_str())) throw InputError(path + ": not a VTK XML ImageData file");
   reader->SetFileName(path.c_str());
@@ -22,7 +22,7 @@ void LoadVti(const std::string& path, HostVolume& out) {
   out.indexToWorld = VtkImageIndexToWorld(image);
 }
 
-void LoadLegacyVtk(const std::string& path, HostVolume& out) {
+void LoadLegacyVtk(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/) {
   vtkNew<vtkStructuredPointsReader> reader;
   reader->SetFileName(path.c_str());
   {

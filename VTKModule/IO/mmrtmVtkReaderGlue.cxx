@@ -3,6 +3,7 @@
 // vtkImageData and reading a vtkImageData's index-to-world geometry.
 #include "mmrtmVolumeLoaderInternal.h"
 
+#include <algorithm>
 #include <cctype>
 #include <memory>
 #include <string>
@@ -12,6 +13,8 @@
 #include <vtkDataArray.h>
 #include <vtkErrorCode.h>
 #include <vtkExecutive.h>
+#include <vtkInformation.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkImageData.h>
 #include <vtkMatrix3x3.h>
 #include <vtkNew.h>
@@ -132,6 +135,21 @@ void ReaderErrors::ThrowIfFailed(const std::string& path) const {
 
 vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path) {
   ReaderErrors errors(reader);
+  // The header first: a volume too large for this machine is refused before
+  // the reader allocates it (its buffer and our copy live together).
+  reader->UpdateInformation();
+  errors.ThrowIfFailed(path);
+  if (vtkInformation* info = reader->GetOutputInformation(0);
+      info && info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT())) {
+    int e[6];
+    info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), e);
+    const double nx = e[1] - e[0] + 1.0, ny = e[3] - e[2] + 1.0, nz = e[5] - e[4] + 1.0;
+    const double bytes = nx * ny * nz * vtkDataArray::GetDataTypeSize(vtkImageData::GetScalarType(info)) *
+                         std::max(1, vtkImageData::GetNumberOfScalarComponents(info));
+    CheckMemoryAvailable(path, 2.0 * bytes,
+                         "reading " + std::to_string((long long)nx) + " x " + std::to_string((long long)ny) + " x " +
+                             std::to_string((long long)nz) + " voxels");
+  }
   reader->Update();
   errors.ThrowIfFailed(path);
   vtkImageData* image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));

@@ -3,8 +3,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <optional>
 #include <set>
 #include <sstream>
+
+#include "derived_proxies.h"
+#include "label_alignment.h"
+#include "label_materials.h"
 
 namespace mmrtm {
 
@@ -71,6 +77,8 @@ RGB Color(const json& v, const std::string& where) {
   return RGB(Number(v[0], where + "[0]"), Number(v[1], where + "[1]"), Number(v[2], where + "[2]"));
 }
 
+std::string SourceOf(const HostVolume& v) { return v.source.empty() ? v.name : v.source; }
+
 std::string Resolve(const std::string& file, const std::string& base) {
   fs::path p(file);
   return p.is_absolute() ? file : (fs::path(base) / p).lexically_normal().string();
@@ -98,6 +106,16 @@ TFType ParseTFType(const json& tf, const std::string& where) {
   Fail(where + ".type", "expected cctf, cpctf, cdptf, mpctf or mdptf, got '" + t + "'");
 }
 
+// A volume computed from another when some TF reads it ("derived": ...).
+struct DerivedSpec {
+  std::string where;  // JSON path, for messages
+  std::string kind;   // gradient_magnitude, smoothed or opacity
+  std::string from;
+  int fromIndex = -1;
+  float sigmaMm = 0.f;
+  std::vector<std::array<float, 2>> points;
+};
+
 class Parser {
  public:
   Parser(const json& doc, SceneInputs inputs) : doc_(doc), in_(std::move(inputs)) {}
@@ -105,8 +123,9 @@ class Parser {
   Scene Parse() {
     CheckKeys(doc_, "scene",
               {"volumes", "materials", "material_tfs", "default_material", "gradient_proxy", "lights", "camera",
-               "render", "description"});
+               "render", "description", "label_materials", "label_table"});
     ParseVolumes();
+    ExpandLabels();
     ParseMaterialNames();
     for (auto it = Materials().begin(); it != Materials().end(); ++it) ParseMaterial(it.key(), it.value());
     ParseMaterialTFs();
@@ -140,6 +159,7 @@ class Parser {
       volume.name = name;
       volumeNames_.push_back(name);
       volumes_.push_back(std::move(volume));
+      derived_.emplace_back();
     }
     if (doc_.contains("volumes")) {
       const json& vols = doc_["volumes"];
@@ -147,6 +167,14 @@ class Parser {
       for (auto it = vols.begin(); it != vols.end(); ++it) {
         const std::string where = "volumes." + it.key();
         if (in_.volumes.count(it.key())) continue;  // given on the command line
+        if (it.value().is_object() && it.value().contains("derived")) {
+          // Computed later, and only if read (KeepReadProxies).
+          derived_.push_back(ParseDerived(it.value(), where));
+          volumes_.emplace_back();
+          volumes_.back().name = it.key();
+          volumeNames_.push_back(it.key());
+          continue;
+        }
         CheckKeys(it.value(), where, {"file", "interpolation"});
         const std::string file = StringOr(it.value(), "file", "", where);
         if (file.empty()) Fail(where + ".file", "a volume needs a file");
@@ -158,9 +186,90 @@ class Parser {
                                           interp == "nearest" ? Interpolation::Nearest : Interpolation::Trilinear));
         volumes_.back().name = it.key();
         volumeNames_.push_back(it.key());
+        derived_.emplace_back();
       }
     }
     if (volumes_.empty()) Fail("volumes", "the scene has no volume (give an input file)");
+    ResolveDerivedSources();
+  }
+
+  DerivedSpec ParseDerived(const json& vj, const std::string& where) {
+    DerivedSpec d;
+    d.where = where;
+    if (!vj["derived"].is_string()) Fail(where + ".derived", "expected gradient_magnitude, smoothed or opacity");
+    d.kind = vj["derived"].get<std::string>();
+    if (d.kind == "gradient_magnitude") {
+      CheckKeys(vj, where, {"derived", "from"});
+    } else if (d.kind == "smoothed") {
+      CheckKeys(vj, where, {"derived", "from", "sigma_mm"});
+      if (!vj.contains("sigma_mm")) Fail(where, "a smoothed volume needs sigma_mm");
+      d.sigmaMm = Number(vj["sigma_mm"], where + ".sigma_mm");
+      if (!(d.sigmaMm > 0.f)) Fail(where + ".sigma_mm", "must be a positive number of mm");
+    } else if (d.kind == "opacity") {
+      CheckKeys(vj, where, {"derived", "from", "points"});
+      const json& pts = vj.contains("points") ? vj["points"] : json();
+      if (!pts.is_array() || pts.empty()) Fail(where + ".points", "an opacity volume needs [[value, opacity], ...]");
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const std::string w = where + ".points[" + std::to_string(i) + "]";
+        if (!pts[i].is_array() || pts[i].size() != 2) Fail(w, "expected [value, opacity]");
+        const float x = Number(pts[i][0], w), o = Number(pts[i][1], w);
+        if (i > 0 && x < d.points.back()[0]) Fail(w, "values must be in ascending order");
+        if (o < 0.f || o > 1.f) Fail(w, "opacity must be in 0..1");
+        d.points.push_back({x, o});
+      }
+    } else {
+      Fail(where + ".derived", "expected gradient_magnitude, smoothed or opacity, got '" + d.kind + "'");
+    }
+    d.from = StringOr(vj, "from", "", where);
+    if (d.from.empty()) Fail(where + ".from", "a derived volume needs 'from', the volume it is computed from");
+    return d;
+  }
+
+  // `from` may name a volume listed after the derived one, so this runs once
+  // all volumes are known.
+  void ResolveDerivedSources() {
+    for (std::optional<DerivedSpec>& d : derived_) {
+      if (!d) continue;
+      for (size_t i = 0; i < volumeNames_.size(); ++i)
+        if (volumeNames_[i] == d->from) d->fromIndex = (int)i;
+      if (d->fromIndex < 0) {
+        std::string list;
+        for (size_t i = 0; i < volumeNames_.size(); ++i)
+          if (!derived_[i]) list += (list.empty() ? "" : ", ") + volumeNames_[i];
+        Fail(d->where + ".from", "no volume named '" + d->from + "' (the scene has: " + list + ")");
+      }
+      if (derived_[d->fromIndex])
+        Fail(d->where + ".from", "'" + d->from + "' is itself derived; derive from a volume read from a file");
+    }
+  }
+
+  // Computes derived volume i from its source (which is still in volumes_).
+  HostVolume ComputeDerived(int i) {
+    const DerivedSpec& d = *derived_[i];
+    const HostVolume& source = volumes_[d.fromIndex];
+    const std::string& name = volumeNames_[i];
+    if (d.kind == "gradient_magnitude") return GradientMagnitudeProxy(source, name);
+    if (d.kind == "smoothed") return SmoothedProxy(source, d.sigmaMm, name);
+    return OpacityProxy(source, d.points, name);
+  }
+
+  // "label_materials" (label_materials.h): one material per label id present
+  // in the label map, named and coloured from the label table.
+  void ExpandLabels() {
+    std::optional<LabelTable> table = in_.labelTable;
+    if (!table && doc_.contains("label_table")) {
+      if (!doc_["label_table"].is_string()) Fail("label_table", "expected a file name");
+      table = ReadLabelTable(Resolve(doc_["label_table"].get<std::string>(), in_.baseDirectory));
+    }
+    if (!doc_.contains("label_materials")) return;
+    const json& block = doc_["label_materials"];
+    const std::string proxy = block.is_object() ? block.value("proxy", std::string("labels")) : "labels";
+    int index = -1;
+    for (size_t i = 0; i < volumeNames_.size(); ++i)
+      if (volumeNames_[i] == proxy && !derived_[i]) index = (int)i;
+    if (index < 0)
+      Fail("label_materials.proxy", "needs the label map '" + proxy + "' (give --labels FILE, or a volume of that name)");
+    doc_ = ExpandLabelMaterials(doc_, LabelIdsPresent(volumes_[index]), table ? &*table : nullptr);
   }
 
   int ProxyByName(const std::string& name, const std::string& where) {
@@ -287,6 +396,26 @@ class Parser {
     std::vector<int> order{primary};
     for (int i : readProxies_)
       if (i != primary) order.push_back(i);
+    // Derived volumes are computed here, once the read set is known, so an
+    // unread one costs nothing; all before any volume is moved, since their
+    // sources may be read too.
+    std::vector<HostVolume> computed(volumes_.size());
+    for (int i : order)
+      if (derived_[i]) computed[i] = ComputeDerived(i);
+    for (int i : order)
+      if (derived_[i]) volumes_[i] = std::move(computed[i]);
+    // Label maps are looked up nearest: one on a grid other than the primary
+    // volume's would shift label boundaries by up to half a label voxel
+    // against the anatomy, so it is put on the primary's grid (continuous
+    // proxies interpolate, and the tracer handles them on any grid).
+    for (int i : order) {
+      if (i == primary || derived_[i] || volumes_[i].interpolation != Interpolation::Nearest) continue;
+      bool resampled = false;
+      volumes_[i] = AlignLabelsToVolume(std::move(volumes_[i]), volumes_[primary], &resampled);
+      if (resampled)
+        std::cerr << "warning: label map " << SourceOf(volumes_[i]) << " was resampled (nearest neighbour) onto the "
+                  << "voxel grid of " << SourceOf(volumes_[primary]) << "\n";
+    }
     std::vector<int> remap(volumes_.size(), -1);
     for (size_t k = 0; k < order.size(); ++k) {
       remap[order[k]] = (int)k;
@@ -428,11 +557,12 @@ class Parser {
     }
   }
 
-  const json& doc_;
+  json doc_;  // a copy: "label_materials" is expanded in place
   SceneInputs in_;
   Scene scene_;
   std::vector<HostVolume> volumes_;
   std::vector<std::string> volumeNames_;
+  std::vector<std::optional<DerivedSpec>> derived_;  // per volume; empty for a volume read from a file
   std::set<int> readProxies_;
 };
 

@@ -4,10 +4,12 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "label_table.h"
 #include "scene.h"
 
 namespace mmrtm {
@@ -23,6 +25,9 @@ struct SceneInputs {
   std::map<std::string, HostVolume> volumes;
   // Folder that relative file names in the document are relative to.
   std::string baseDirectory = ".";
+  // Label names and colours for "label_materials" (the command line's
+  // --label-table); takes the place of the scene's "label_table" file.
+  std::optional<LabelTable> labelTable;
 };
 
 // Reads a JSON document from a file; throws InputError naming the file and

@@ -1,0 +1,108 @@
+// Tests of the "label_materials" expansion: one material per label, named
+// and coloured from a label table, selected by an MDPTF that takes priority.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "label_materials.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace mmrtm {
+namespace {
+
+json Classes() {
+  return json::parse(R"({
+    "label_materials": {
+      "classes": [
+        {"match": ["artery", "aorta"], "color": "material", "material": {"density": 4, "albedo": [0.9, 0.1, 0.1]}},
+        {"match": ["vertebra"], "material": {"density": 3}},
+        {"match": ["*"], "material": {"density": 2}}
+      ]
+    },
+    "materials": {"tissue": {"density": 1}},
+    "material_tfs": [{"type": "mpctf", "proxy": "scalars", "ranges": [[100, 200, "tissue"]]}]
+  })");
+}
+
+LabelTable Table() {
+  const std::string path = std::string(MMRTM_TEST_OUTPUT_DIR) + "/label_materials_table.txt";
+  std::ofstream(path) << "# test\n1 aorta\n2 vertebrae_T12 255 0 0\n3 liver 0 255 0 255\n";
+  return ReadLabelTable(path);
+}
+
+TEST(LabelMaterials, OneMaterialPerLabelFirstMatchingClassWins) {
+  const LabelTable table = Table();
+  const json doc = ExpandLabelMaterials(Classes(), {1, 2, 3, 9}, &table);
+  EXPECT_FALSE(doc.contains("label_materials"));
+  const json& m = doc["materials"];
+  ASSERT_EQ(m.size(), 5u);  // tissue + 4 labels
+  EXPECT_EQ(m["aorta"]["density"], 4);
+  EXPECT_EQ(m["aorta"]["albedo"], json({0.9, 0.1, 0.1}));  // the class's own colour
+  EXPECT_EQ(m["vertebrae_T12"]["density"], 3);
+  EXPECT_EQ(m["vertebrae_T12"]["albedo"], json({1.0, 0.0, 0.0}));  // the table's colour
+  EXPECT_EQ(m["liver"]["density"], 2);
+  const RGB palette = DefaultLabelColor(9);
+  EXPECT_FLOAT_EQ(m["label_9"]["albedo"][1].get<float>(), palette[1]);  // not in the table
+  // The labels' MDPTF comes first, then the scene's own material TFs.
+  ASSERT_EQ(doc["material_tfs"].size(), 2u);
+  EXPECT_EQ(doc["material_tfs"][0]["type"], "mdptf");
+  EXPECT_EQ(doc["material_tfs"][0]["proxy"], "labels");
+  EXPECT_EQ(doc["material_tfs"][0]["points"], json({{1, "aorta"}, {2, "vertebrae_T12"}, {3, "liver"}, {9, "label_9"}}));
+  EXPECT_EQ(doc["material_tfs"][1]["type"], "mpctf");
+}
+
+TEST(LabelMaterials, UnmatchedLabelsStayUnclaimed) {
+  json doc = Classes();
+  doc["label_materials"]["classes"].erase(2);  // no "*"
+  const LabelTable table = Table();
+  const json out = ExpandLabelMaterials(doc, {1, 3}, &table);
+  EXPECT_TRUE(out["materials"].contains("aorta"));
+  EXPECT_FALSE(out["materials"].contains("liver"));
+  EXPECT_EQ(out["material_tfs"][0]["points"].size(), 1u);
+}
+
+TEST(LabelMaterials, NameClashWithASceneMaterialKeepsBoth) {
+  json doc = Classes();
+  doc["materials"]["liver"] = {{"density", 7}};
+  const LabelTable table = Table();
+  const json out = ExpandLabelMaterials(doc, {3}, &table);
+  EXPECT_EQ(out["materials"]["liver"]["density"], 7);
+  EXPECT_EQ(out["materials"]["liver_3"]["density"], 2);
+}
+
+TEST(LabelMaterials, ErrorsNameThePath) {
+  json doc = Classes();
+  doc["label_materials"]["classes"][0]["colour"] = "table";
+  try {
+    ExpandLabelMaterials(doc, {1}, nullptr);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("label_materials.classes[0]: unknown key 'colour'"), std::string::npos)
+        << e.what();
+  }
+  doc = Classes();
+  doc["label_materials"]["classes"][1]["match"] = json::array();
+  EXPECT_THROW(ExpandLabelMaterials(doc, {1}, nullptr), InputError);
+}
+
+TEST(LabelMaterials, IdsPresentInAVolume) {
+  HostVolume v;
+  v.name = "labels";
+  v.source = "test";
+  v.dims = {4, 1, 1};
+  v.type = VoxelType::UInt16;
+  const uint16_t values[4] = {0, 300, 7, 300};
+  v.voxels.assign(reinterpret_cast<const uint8_t*>(values), reinterpret_cast<const uint8_t*>(values) + 8);
+  EXPECT_EQ(LabelIdsPresent(v), (std::vector<int>{7, 300}));
+  v.type = VoxelType::Float32;
+  const float fractional[2] = {1.5f, 2.f};
+  v.dims = {2, 1, 1};
+  v.voxels.assign(reinterpret_cast<const uint8_t*>(fractional), reinterpret_cast<const uint8_t*>(fractional) + 8);
+  EXPECT_THROW(LabelIdsPresent(v), InputError);
+}
+
+}  // namespace
+}  // namespace mmrtm

@@ -1,0 +1,129 @@
+// See label_materials.h.
+#include "label_materials.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <set>
+
+namespace mmrtm {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void Fail(const std::string& where, const std::string& problem) {
+  throw InputError(where + ": " + problem);
+}
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return (char)std::tolower(c); });
+  return s;
+}
+
+template <typename T>
+void CollectIds(const T* v, int64_t n, std::set<int>& ids, const HostVolume& labels) {
+  for (int64_t i = 0; i < n; ++i) {
+    const float f = (float)v[i];
+    if (f == 0.f) continue;
+    if (f != std::floor(f) || std::fabs(f) > 1e7f)
+      throw InputError(labels.source + ": label maps hold integer ids, found " + std::to_string(f));
+    ids.insert((int)f);
+  }
+}
+
+struct LabelClass {
+  std::vector<std::string> match;  // lower case
+  json material;
+  bool colorFromTable = true;
+};
+
+std::vector<LabelClass> ParseClasses(const json& block) {
+  if (!block.contains("classes") || !block["classes"].is_array() || block["classes"].empty())
+    Fail("label_materials.classes", "expected a list of classes");
+  std::vector<LabelClass> classes;
+  for (size_t i = 0; i < block["classes"].size(); ++i) {
+    const std::string where = "label_materials.classes[" + std::to_string(i) + "]";
+    const json& c = block["classes"][i];
+    if (!c.is_object()) Fail(where, "expected an object");
+    for (auto it = c.begin(); it != c.end(); ++it)
+      if (it.key() != "match" && it.key() != "material" && it.key() != "color")
+        Fail(where, "unknown key '" + it.key() + "' (known: match, material, color)");
+    LabelClass lc;
+    if (!c.contains("match") || !c["match"].is_array() || c["match"].empty())
+      Fail(where + ".match", "expected a list of name fragments (\"*\" matches every label)");
+    for (const json& m : c["match"]) {
+      if (!m.is_string() || m.get<std::string>().empty()) Fail(where + ".match", "expected non-empty strings");
+      lc.match.push_back(Lower(m.get<std::string>()));
+    }
+    lc.material = c.value("material", json::object());
+    if (!lc.material.is_object()) Fail(where + ".material", "expected a material object");
+    if (lc.material.contains("tfs")) Fail(where + ".material.tfs", "label materials take constant coefficients");
+    const std::string color = c.value("color", std::string("table"));
+    if (color != "table" && color != "material") Fail(where + ".color", "expected \"table\" or \"material\"");
+    lc.colorFromTable = color == "table";
+    classes.push_back(std::move(lc));
+  }
+  return classes;
+}
+
+const LabelClass* MatchClass(const std::vector<LabelClass>& classes, const std::string& name) {
+  const std::string lower = Lower(name);
+  for (const LabelClass& c : classes)
+    for (const std::string& m : c.match)
+      if (m == "*" || lower.find(m) != std::string::npos) return &c;
+  return nullptr;
+}
+
+}  // namespace
+
+std::vector<int> LabelIdsPresent(const HostVolume& labels) {
+  std::set<int> ids;
+  const int64_t n = labels.VoxelCount();
+  const void* p = labels.voxels.data();
+  switch (labels.type) {
+    case VoxelType::UInt8: CollectIds(static_cast<const uint8_t*>(p), n, ids, labels); break;
+    case VoxelType::Int16: CollectIds(static_cast<const int16_t*>(p), n, ids, labels); break;
+    case VoxelType::UInt16: CollectIds(static_cast<const uint16_t*>(p), n, ids, labels); break;
+    case VoxelType::Float32: CollectIds(static_cast<const float*>(p), n, ids, labels); break;
+  }
+  return {ids.begin(), ids.end()};
+}
+
+json ExpandLabelMaterials(json doc, const std::vector<int>& ids, const LabelTable* table) {
+  if (!doc.contains("label_materials")) return doc;
+  const json block = doc["label_materials"];
+  doc.erase("label_materials");
+  if (!block.is_object()) Fail("label_materials", "expected an object");
+  for (auto it = block.begin(); it != block.end(); ++it)
+    if (it.key() != "proxy" && it.key() != "classes")
+      Fail("label_materials", "unknown key '" + it.key() + "' (known: proxy, classes)");
+  const std::string proxy = block.value("proxy", std::string("labels"));
+  const std::vector<LabelClass> classes = ParseClasses(block);
+
+  if (!doc.contains("materials")) doc["materials"] = json::object();
+  json points = json::array();
+  for (int id : ids) {
+    const LabelEntry* entry = table ? table->Find(id) : nullptr;
+    std::string name = entry ? entry->name : "label_" + std::to_string(id);
+    const LabelClass* c = MatchClass(classes, name);
+    if (!c) continue;
+    while (doc["materials"].contains(name)) name += "_" + std::to_string(id);  // keep the scene's own materials
+    json material = c->material;
+    if (c->colorFromTable || !material.contains("albedo")) {
+      const RGB color = entry ? entry->color : DefaultLabelColor(id);
+      material["albedo"] = {color[0], color[1], color[2]};
+    }
+    doc["materials"][name] = material;
+    points.push_back({id, name});
+  }
+  if (points.empty()) return doc;  // no label matched: nothing to select
+  json selectors = json::array({{{"type", "mdptf"}, {"proxy", proxy}, {"points", points}}});
+  if (doc.contains("material_tfs")) {
+    if (!doc["material_tfs"].is_array()) Fail("material_tfs", "expected a list, highest priority first");
+    for (const json& tf : doc["material_tfs"]) selectors.push_back(tf);
+  }
+  doc["material_tfs"] = selectors;
+  return doc;
+}
+
+}  // namespace mmrtm
