@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "label_alignment.h"
 #include "mmrtmVolumeLoader.h"
 
 namespace fs = std::filesystem;
@@ -188,6 +189,32 @@ TEST(VolumeLoader, NiftiAndNrrdOfOneHeadAgreeInWorld) {
     const Vec3 w = World(nifti, 159 - i.x, 231 - i.y, i.z);
     ExpectWorld(mask, i, w, 2e-3f);
   }
+}
+
+// A label map with another orientation (the NRRD brain mask, its array
+// mirrored in x and y against the MRI) aligned onto the MRI's grid in world
+// space gives the labels of mr_head_labels.nii.gz, which was made on that
+// grid by flipping the arrays: brain (1) exactly where the mask is set.
+TEST(VolumeLoader, MirroredLabelMapAlignsToTheVolume) {
+  const HostVolume mri = LoadVolume(Data("mr_head.nii.gz"));
+  const HostVolume mask = LoadVolume(Data("mr_head_brain_mask.nrrd"), "labels", mmrtm::Interpolation::Nearest);
+  const HostVolume labels = LoadVolume(Data("mr_head_labels.nii.gz"), "labels", mmrtm::Interpolation::Nearest);
+  bool resampled = false;
+  const HostVolume aligned = mmrtm::AlignLabelsToVolume(mask, mri, &resampled);
+  EXPECT_TRUE(resampled);
+  ASSERT_EQ(aligned.dims, mri.dims);
+  int64_t brain = 0, disagree = 0, naiveDisagree = 0;
+  for (int64_t i = 0; i < aligned.VoxelCount(); ++i) {
+    const bool isBrain = labels.Value(i) == 1.f;
+    brain += isBrain;
+    disagree += isBrain != (aligned.Value(i) != 0.f);
+    naiveDisagree += isBrain != (mask.Value(i) != 0.f);
+  }
+  EXPECT_GT(brain, 100000);
+  EXPECT_EQ(disagree, 0) << "voxels where the aligned mask and the brain label differ";
+  // The test is not vacuous: the brain is nearly symmetric, yet the mirrored
+  // array taken voxel by voxel is wrong in many voxels.
+  EXPECT_GT(naiveDisagree, brain / 10);
 }
 
 TEST(VolumeLoader, NiftiInt32BecomesInt16) {
