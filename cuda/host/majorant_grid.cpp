@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <thread>
+
+#include "parallel_for.h"
 
 namespace mmrtm {
 
@@ -13,20 +14,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Runs fn(begin, end) over [0, n) in contiguous chunks on `threads` threads.
-template <typename Fn>
-void ParallelFor(int64_t n, int threads, Fn fn) {
-  if (threads <= 0) threads = (int)std::max(1u, std::thread::hardware_concurrency());
-  threads = (int)std::min<int64_t>(threads, std::max<int64_t>(n, 1));
-  if (threads <= 1) {
-    fn((int64_t)0, n);
-    return;
-  }
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) pool.emplace_back(fn, n * t / threads, n * (t + 1) / threads);
-  for (std::thread& t : pool) t.join();
-}
-
 // Sets bins [b0, b1] of a kSummaryWords-word mask.
 inline void SetBinRange(uint64_t* words, int b0, int b1) {
   for (int w = b0 >> 6; w <= (b1 >> 6); ++w) {
@@ -34,13 +21,6 @@ inline void SetBinRange(uint64_t* words, int b0, int b1) {
     const uint64_t upper = hi == 63 ? ~0ull : ((1ull << (hi + 1)) - 1);
     words[w] |= upper & ~((1ull << lo) - 1);
   }
-}
-
-// Calls fn(bin) for every set bin of a mask.
-template <typename Fn>
-inline void ForEachBin(const uint64_t* words, Fn fn) {
-  for (int w = 0; w < kSummaryWords; ++w)
-    for (uint64_t bits = words[w]; bits; bits &= bits - 1) fn((w << 6) + __builtin_ctzll(bits));
 }
 
 // The bins of a voxel block [lo, hi] (inclusive) of one proxy: each voxel's
@@ -291,6 +271,33 @@ void MajorantGrid::RefitFromVoxelValues(const Classifier& c) {
   });
 }
 
+MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) const {
+  // Per TF and bin: the TF's maximum (coefficient TFs) or the materials it
+  // can pick (material TFs) over the bin's value range.
+  RefitTables t;
+  t.binMax.assign((size_t)c.tfCount * kSummaryBins, 0.f);
+  t.binMaterials.assign((size_t)c.tfCount * kSummaryBins, 0);
+  t.materialMasks = c.materialCount <= 64;
+  for (int i = 0; i < c.tfCount; ++i) {
+    const TransferFunctionView& tf = c.tfs[i];
+    for (int b = 0; b < kSummaryBins; ++b) {
+      float lo, hi;
+      bins_[tf.proxy].Range(b, &lo, &hi);
+      if (IsMaterialTF(tf.type)) {
+        uint64_t mask = 0;
+        for (int e = 0; e < tf.count; ++e)
+          if (tf.EntryInRange(e, lo, hi)) mask |= 1ull << (tf.materials[e] & 63);
+        t.binMaterials[(size_t)i * kSummaryBins + b] = mask;
+      } else {
+        float v[kMaxTFChannels];
+        tf.MaxOverRange(lo, hi, v);
+        t.binMax[(size_t)i * kSummaryBins + b] = v[0];
+      }
+    }
+  }
+  return t;
+}
+
 void MajorantGrid::Refit(const Classifier& c) {
   const auto start = Clock::now();
   if (options_.summary == SummaryMode::VoxelValues) {
@@ -299,62 +306,17 @@ void MajorantGrid::Refit(const Classifier& c) {
     refitSeconds_ = SecondsSince(start);
     return;
   }
-  // Per TF and bin: the TF's maximum (coefficient TFs) or the materials it
-  // can pick (material TFs) over the bin's value range.
-  std::vector<float> binMax((size_t)c.tfCount * kSummaryBins, 0.f);
-  std::vector<uint64_t> binMaterials((size_t)c.tfCount * kSummaryBins, 0);
-  const bool materialMasks = c.materialCount <= 64;
-  for (int t = 0; t < c.tfCount; ++t) {
-    const TransferFunctionView& tf = c.tfs[t];
-    for (int b = 0; b < kSummaryBins; ++b) {
-      float lo, hi;
-      bins_[tf.proxy].Range(b, &lo, &hi);
-      if (IsMaterialTF(tf.type)) {
-        uint64_t mask = 0;
-        for (int i = 0; i < tf.count; ++i)
-          if (tf.EntryInRange(i, lo, hi)) mask |= 1ull << (tf.materials[i] & 63);
-        binMaterials[(size_t)t * kSummaryBins + b] = mask;
-      } else {
-        float v[kMaxTFChannels];
-        tf.MaxOverRange(lo, hi, v);
-        binMax[(size_t)t * kSummaryBins + b] = v[0];
-      }
-    }
-  }
-
-  // Leaves.
-  const int L = view_.leafLevel;
-  const int64_t leaves = LeafCount();
-  ParallelFor(leaves, options_.threads, [&](int64_t begin, int64_t end) {
-    for (int64_t leaf = begin; leaf < end; ++leaf) {
-      auto summary = [&](int proxy) { return &summaries_[proxy][(size_t)leaf * kSummaryWords]; };
-      // The materials that can occur: the default, and whatever a material
-      // TF can pick from the leaf's bins (all of them if there are too many
-      // materials for a mask).
-      uint64_t candidates = c.defaultMaterial != kNoMaterial ? 1ull << c.defaultMaterial : 0;
-      for (int s = 0; s < c.selectorCount && materialMasks; ++s) {
-        const int t = c.selectors[s];
-        ForEachBin(summary(c.tfs[t].proxy),
-                   [&](int b) { candidates |= binMaterials[(size_t)t * kSummaryBins + b]; });
-      }
-      float majorant = 0.f;
-      for (int m = 0; m < c.materialCount; ++m) {
-        if (materialMasks && !(candidates & (1ull << m))) continue;
-        const MaterialView& mat = c.materials[m];
-        float d = mat.base[0];
-        for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
-          const int t = c.bindings[mat.bindingBegin + b].tf;
-          float mx = 0.f;
-          ForEachBin(summary(c.tfs[t].proxy),
-                     [&](int bin) { mx = std::max(mx, binMax[(size_t)t * kSummaryBins + bin]); });
-          d *= mx;
-        }
-        majorant = std::max(majorant, d);
-      }
-      majorants_[view_.offset[L] + leaf] = majorant;
-    }
+  const RefitTables tables = MakeRefitTables(c);
+  RefitInputs in;
+  for (int k = 0; k < proxyCount_; ++k) in.summaries[k] = summaries_[k].data();
+  in.binMax = tables.binMax.data();
+  in.binMaterials = tables.binMaterials.data();
+  in.materialMasks = tables.materialMasks;
+  // Leaves (the same per-leaf function as the CUDA refit), then the levels above.
+  const int64_t leafOffset = view_.offset[view_.leafLevel];
+  ParallelFor(LeafCount(), options_.threads, [&](int64_t begin, int64_t end) {
+    for (int64_t leaf = begin; leaf < end; ++leaf) majorants_[leafOffset + leaf] = LeafMajorant(c, in, leaf);
   });
-
   RefitUpperLevels();
   refitSeconds_ = SecondsSince(start);
 }
@@ -363,16 +325,10 @@ void MajorantGrid::RefitUpperLevels() {
   // Bottom-up: each node the maximum of its children.
   for (int l = view_.leafLevel - 1; l >= 0; --l) {
     const int* r = view_.res[l];
-    const int* rc = view_.res[l + 1];
     for (int z = 0; z < r[2]; ++z)
       for (int y = 0; y < r[1]; ++y)
         for (int x = 0; x < r[0]; ++x) {
-          float mx = 0.f;
-          for (int cz = 2 * z; cz <= std::min(2 * z + 1, rc[2] - 1); ++cz)
-            for (int cy = 2 * y; cy <= std::min(2 * y + 1, rc[1] - 1); ++cy)
-              for (int cx = 2 * x; cx <= std::min(2 * x + 1, rc[0] - 1); ++cx)
-                mx = std::max(mx, majorants_[view_.Index(l + 1, cx, cy, cz)]);
-          majorants_[view_.Index(l, x, y, z)] = mx;
+          majorants_[view_.Index(l, x, y, z)] = UpperNodeMajorant(view_, majorants_.data(), l, x, y, z);
         }
   }
 }

@@ -36,6 +36,7 @@
 #include "host_volume.h"
 #include "mmrtm/classifier.h"
 #include "mmrtm/majorant_grid.h"
+#include "mmrtm/majorant_refit.h"
 
 namespace mmrtm {
 
@@ -59,8 +60,6 @@ struct MajorantGridOptions {
 // paper's level 6), a 256^3 one 4-cell leaves.
 constexpr int64_t kMaxAutoLeaves = int64_t(1) << 19;
 constexpr float kPositionTolerance = 1e-3f;  // voxels; see "Rounding" above
-constexpr int kSummaryBins = 256;
-constexpr int kSummaryWords = kSummaryBins / 64;
 
 class MajorantGrid {
  public:
@@ -72,6 +71,18 @@ class MajorantGrid {
   // Recomputes every majorant for the classifier's TFs and materials.
   void Refit(const Classifier& classifier);
 
+  // The per-TF bin tables a refit reads (mmrtm/majorant_refit.h), for the
+  // classifier's TFs; the CUDA refit uploads them with Summaries().
+  struct RefitTables {
+    std::vector<float> binMax;
+    std::vector<uint64_t> binMaterials;
+    bool materialMasks = true;
+  };
+  RefitTables MakeRefitTables(const Classifier& classifier) const;
+  // Proxy k's leaf summaries: kSummaryWords words per leaf (empty with
+  // SummaryMode::VoxelValues, whose refit reads the voxels instead).
+  const std::vector<uint64_t>& Summaries(int proxy) const { return summaries_[proxy]; }
+  int ProxyCount() const { return proxyCount_; }
   const MajorantGridView& View() const { return view_; }
   int LeafLevel() const { return view_.leafLevel; }
   int64_t LeafCount() const;
