@@ -12,13 +12,15 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <thread>
 
 #include <unistd.h>
 
-#include "cpu_renderer.h"
 #include "image_io.h"
 #include "mmrtmVolumeLoader.h"
+#include "render_backend.h"
 #include "scene_json.h"
 
 namespace fs = std::filesystem;
@@ -51,6 +53,8 @@ options:
   --spp N               samples per pixel (default: scene, else 64)
   --seed S              random seed (default: scene, else 0)
   --threads T           CPU threads, 0 for all (default: 0)
+  --backend B           auto (CUDA when a device is present, else the CPU; default),
+                        cpu, or cuda (an error without a CUDA device)
   --estimator E         delta (unbiased, default) or raymarch (biased baseline)
   --accelerator A       majorants for delta tracking: none (one global majorant),
                         macrocell (uniform grid), octree (default: the hierarchical
@@ -70,6 +74,7 @@ options:
 struct Options {
   std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear, statsJson;
   json render = json::object();  // overrides of the scene's "render" block
+  mmrtm::Backend backend = mmrtm::Backend::Auto;
   bool quiet = false, listSeries = false;
 };
 
@@ -122,6 +127,12 @@ Options ParseArguments(int argc, char** argv) {
     else if (a == "--spp") o.render["spp"] = ParseInteger(a, value(), 1, 1 << 24);
     else if (a == "--seed") o.render["seed"] = (uint64_t)ParseInteger(a, value(), 0, 0x7fffffffL);
     else if (a == "--threads") o.render["threads"] = ParseInteger(a, value(), 0, 1024);
+    else if (a == "--backend") {
+      const std::string b = value();
+      const auto backend = mmrtm::ParseBackend(b);
+      if (!backend) UsageError("--backend expects auto, cpu or cuda, got '" + b + "'");
+      o.backend = *backend;
+    }
     else if (a == "--max-bounces") o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);
     else if (a == "--shadow-scale") o.render["shadow_extinction_scale"] = ParseReal(a, value());
     else if (a == "--exposure") o.render["exposure"] = ParseReal(a, value());
@@ -200,6 +211,7 @@ int ListSeries(const Options& o) {
 int Run(const Options& o) {
   if (o.listSeries) return ListSeries(o);
   const auto tStart = std::chrono::steady_clock::now();
+  mmrtm::RequireBackend(o.backend);
   CheckWritable(o.output);
   CheckWritable(o.outputLinear);
   CheckWritable(o.statsJson);
@@ -249,16 +261,19 @@ int Run(const Options& o) {
   const double buildSeconds = SecondsSince(tBuild);
 
   const mmrtm::RenderSettings& rs = scene.render;
-  mmrtm::CpuRenderer renderer(rs.threads);
+  const auto note = [&](const std::string& text) {
+    if (!o.quiet) std::fprintf(stderr, "note: %s\n", text.c_str());
+  };
+  std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note);
   mmrtm::Film film(rs.width, rs.height);
   mmrtm::TraceCounters counters;
   if (!o.quiet)
-    std::fprintf(stderr, "%d x %d, %d spp, %d thread(s), %s, majorant %.4g /mm\n", rs.width, rs.height,
-                 rs.samplesPerPixel, renderer.Threads(),
+    std::fprintf(stderr, "%d x %d, %d spp, %s, %s, majorant %.4g /mm\n", rs.width, rs.height,
+                 rs.samplesPerPixel, renderer->Description().c_str(),
                  rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
                  view.majorants.globalMajorant);
   ProgressBar bar(!o.quiet);
-  renderer.Render(view, film, rs.samplesPerPixel, &counters, [&](int d, int t) { bar(d, t); });
+  renderer->Render(scene, view, film, rs.samplesPerPixel, &counters, [&](int d, int t) { bar(d, t); });
   const double renderSeconds = bar.Seconds();
 
   mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, film.ToneMapped(rs.exposure, rs.toneMapper));
@@ -275,7 +290,8 @@ int Run(const Options& o) {
         {"width", film.Width()},
         {"height", film.Height()},
         {"spp", film.Samples()},
-        {"threads", renderer.Threads()},
+        {"threads", rs.threads > 0 ? rs.threads : (int)std::thread::hardware_concurrency()},
+        {"backend", renderer->Description()},
         {"seed", rs.integrator.seed},
         {"estimator", rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "raymarch" : "delta"},
         {"shadow_extinction_scale", rs.integrator.shadowExtinctionScale},

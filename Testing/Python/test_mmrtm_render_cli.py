@@ -135,6 +135,23 @@ class RenderCli(unittest.TestCase):
         self.expect_failure(self.run_render(os.path.join(DATA, "cta_chest_aorta.nii.gz"), "--labels", far,
                                             "--preset", "ct-angio-labels"), "far.nrrd", "overlap")
 
+    def test_backend_choice(self):
+        # auto renders anywhere; cuda renders with a device and is a clear
+        # error without one (CI has nvcc but no GPU).
+        stats = os.path.join(self.dir, "auto.json")
+        r = self.run_render(HEADSQ, "--width", "16", "--height", "16", "--spp", "1", "--stats-json", stats)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(stats) as f:
+            auto = json.load(f)["backend"]
+        os.remove(self.png)
+        r = self.run_render(HEADSQ, "--backend", "cuda", "--width", "16", "--height", "16", "--spp", "1")
+        if auto.startswith("cuda"):
+            self.assertEqual(r.returncode, 0, r.stderr)
+        else:
+            self.assertTrue(auto.startswith("cpu"), auto)
+            self.expect_failure(r, "--backend cuda: ")
+        self.expect_failure(self.run_render(HEADSQ, "--backend", "gpu"), "--backend expects auto, cpu or cuda", code=2)
+
     def test_missing_input(self):
         self.expect_failure(self.run_render(os.path.join(self.dir, "nope.nrrd")), "nope.nrrd")
 
@@ -190,7 +207,7 @@ class RenderCli(unittest.TestCase):
     def test_help_lists_every_option(self):
         r = subprocess.run([RENDER, "--help"], capture_output=True, text=True, timeout=60)
         self.assertEqual(r.returncode, 0)
-        for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--width", "--height", "--spp", "--seed", "--threads",
+        for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--backend", "--width", "--height", "--spp", "--seed", "--threads",
                        "--estimator", "--output", "--output-linear", "--stats-json"]:
             self.assertIn(option, r.stdout)
 

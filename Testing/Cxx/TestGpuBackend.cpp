@@ -1,0 +1,101 @@
+// The CUDA backend against the CPU backend, on a GPU machine (`ctest -L gpu`;
+// Documentation/gpu.md). Without a device every test is skipped with the
+// reason. The integrator and the refit are the same source on both sides:
+//   - the refit is integer-exact logic over the same summaries and tables,
+//     so the GPU majorants equal the CPU ones bit for bit;
+//   - the images of one seed take the same random numbers; they differ only
+//     where device and host maths round differently (sinf, expf), which can
+//     flip a rare Russian-roulette or collision decision, so nearly every
+//     pixel agrees to float tolerance and the whole image agrees in z-score.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cpu_renderer.h"
+#include "cuda_device.h"
+#include "gpu_renderer.h"
+#include "mmrtmVolumeLoader.h"
+#include "scene_json.h"
+
+namespace mmrtm {
+namespace {
+
+#define SKIP_WITHOUT_DEVICE()                                                                           \
+  if (!CudaDevice().available) GTEST_SKIP() << "no CUDA device here (" << CudaDevice().reason           \
+                                            << "); run `ctest -L gpu` on a GPU machine (Documentation/gpu.md)"
+
+Scene HeadScene(uint64_t seed) {
+  nlohmann::json doc = ReadJsonFile(std::string(MMRTM_DATA_DIR) + "/presets/ct-bone.json");
+  doc["render"] = {{"width", 96}, {"height", 96}, {"spp", 16}, {"seed", seed}};
+  SceneInputs inputs;
+  inputs.volumes["scalars"] = LoadVolume(std::string(MMRTM_SHARED_DATA_DIR) + "/ct_head_cranium.nrrd");
+  return SceneFromJson(doc, std::move(inputs));
+}
+
+TEST(GpuBackend, RefitEqualsTheCpuRefitExactly) {
+  SKIP_WITHOUT_DEVICE();
+  Scene scene = HeadScene(1);
+  const SceneView view = scene.Build();
+  const MajorantGrid& grid = *scene.Grid();
+  GpuRenderer gpu;
+  gpu.SetScene(view, true);
+  // Spoil nothing on the host: the device refit must reproduce the host's.
+  gpu.Refit(grid, view.classifier, true);
+  const std::vector<float> device = gpu.DownloadMajorants();
+  ASSERT_EQ((int64_t)device.size(), grid.NodeCount());
+  const float* host = grid.View().majorants;
+  int64_t differ = 0, nonZero = 0;
+  for (size_t i = 0; i < device.size(); ++i) {
+    differ += device[i] != host[i];
+    nonZero += host[i] > 0.f;
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(nonZero, 0);
+}
+
+TEST(GpuBackend, ImageMatchesTheCpuImageOfTheSameSeed) {
+  SKIP_WITHOUT_DEVICE();
+  Scene scene = HeadScene(7);
+  const SceneView view = scene.Build();
+  Film cpu(96, 96), gpu(96, 96);
+  TraceCounters cpuCounters, gpuCounters;
+  CpuRenderer(0).Render(view, cpu, 16, &cpuCounters);
+  GpuRenderer renderer;
+  renderer.SetScene(view, true);
+  renderer.Render(gpu, 16, &gpuCounters);
+  int close = 0;
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 96; ++x) {
+      const RGB a = cpu.Mean(x, y), b = gpu.Mean(x, y);
+      bool ok = true;
+      for (int c = 0; c < 3; ++c) ok = ok && std::fabs(a[c] - b[c]) <= 1e-4f + 1e-3f * std::fabs(a[c]);
+      close += ok;
+    }
+  EXPECT_GE(close, 96 * 96 * 99 / 100) << "pixels equal to float tolerance";
+  EXPECT_LT(MeanSquaredZScore(cpu, gpu), 0.1);
+  EXPECT_EQ(gpuCounters.paths, cpuCounters.paths);
+  EXPECT_EQ(gpuCounters.majorantViolations, 0u);
+}
+
+TEST(GpuBackend, AccumulationContinuesOnTheDevice) {
+  SKIP_WITHOUT_DEVICE();
+  Scene scene = HeadScene(3);
+  const SceneView view = scene.Build();
+  GpuRenderer renderer;
+  renderer.SetScene(view, true);
+  Film twice(64, 64), once(64, 64);
+  renderer.Render(twice, 4);
+  renderer.Render(twice, 4);
+  GpuRenderer other;
+  other.SetScene(view, true);
+  other.Render(once, 8);
+  EXPECT_EQ(twice.Samples(), 8u);
+  const RGBImage a = twice.Linear(), b = once.Linear();
+  int differ = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) differ += a.pixels[i][c] != b.pixels[i][c];
+  EXPECT_EQ(differ, 0);
+}
+
+}  // namespace
+}  // namespace mmrtm

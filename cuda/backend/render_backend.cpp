@@ -1,0 +1,107 @@
+#include "render_backend.h"
+
+#include <atomic>
+#include <cstdio>
+
+#include "cpu_renderer.h"
+#if MMRTM_HAVE_CUDA
+#include "cuda_device.h"
+#include "device_buffer.h"
+#include "gpu_renderer.h"
+#endif
+
+namespace mmrtm {
+namespace {
+
+class CpuBackend : public Renderer {
+ public:
+  explicit CpuBackend(int threads) : cpu_(threads) {}
+  std::string Description() const override { return "cpu, " + std::to_string(cpu_.Threads()) + " thread(s)"; }
+  bool IsCuda() const override { return false; }
+  void Render(const Scene&, const SceneView& view, Film& film, int spp, TraceCounters* counters,
+              const Progress& progress) override {
+    cpu_.Render(view, film, spp, counters, progress);
+  }
+
+ private:
+  CpuRenderer cpu_;
+};
+
+#if MMRTM_HAVE_CUDA
+class CudaBackend : public Renderer {
+ public:
+  // With `fallbackThreads` >= 0 (auto), a scene too large for the device is
+  // rendered on the CPU instead, with a note; otherwise the error stands.
+  CudaBackend(int fallbackThreads, std::function<void(const std::string&)> note)
+      : fallbackThreads_(fallbackThreads), note_(std::move(note)) {}
+  std::string Description() const override {
+    if (fallback_) return fallback_->Description() + " (fallen back from cuda)";
+    return "cuda, " + CudaDevice().name;
+  }
+  bool IsCuda() const override { return !fallback_; }
+  void Render(const Scene& scene, const SceneView& view, Film& film, int spp, TraceCounters* counters,
+              const Progress& progress) override {
+    if (fallback_) return fallback_->Render(scene, view, film, spp, counters, progress);
+    try {
+      // Every call uploads the view (the caller renders after a change);
+      // the voxels only the first time.
+      gpu_.SetScene(view, first_);
+      const MajorantGrid* grid = scene.Grid();
+      if (grid && view.majorants.kind != MajorantKind::Global &&
+          scene.render.accelerator.grid.summary == SummaryMode::CellRanges)
+        gpu_.Refit(*grid, view.classifier, first_);
+      first_ = false;
+      gpu_.Render(film, spp, counters, progress);
+    } catch (const DeviceMemoryError& e) {
+      if (fallbackThreads_ < 0) throw;
+      if (note_) note_(std::string(e.what()) + "; rendering on the CPU instead");
+      fallback_ = std::make_unique<CpuBackend>(fallbackThreads_);
+      fallback_->Render(scene, view, film, spp, counters, progress);
+    }
+  }
+
+ private:
+  GpuRenderer gpu_;
+  int fallbackThreads_;
+  std::function<void(const std::string&)> note_;
+  std::unique_ptr<CpuBackend> fallback_;
+  bool first_ = true;
+};
+#endif
+
+}  // namespace
+
+std::optional<Backend> ParseBackend(const std::string& name) {
+  if (name == "auto") return Backend::Auto;
+  if (name == "cpu") return Backend::Cpu;
+  if (name == "cuda") return Backend::Cuda;
+  return std::nullopt;
+}
+
+bool CudaBackendBuilt() { return MMRTM_HAVE_CUDA != 0; }
+
+void RequireBackend(Backend backend) {
+  if (backend != Backend::Cuda) return;
+#if MMRTM_HAVE_CUDA
+  if (!CudaDevice().available) throw BackendError("--backend cuda: " + CudaDevice().reason);
+#else
+  throw BackendError("--backend cuda: this build has no CUDA backend (configure with MMRTM_ENABLE_CUDA=ON and nvcc)");
+#endif
+}
+
+std::unique_ptr<Renderer> MakeRenderer(Backend backend, int threads,
+                                       const std::function<void(const std::string&)>& note) {
+  if (backend == Backend::Cpu) return std::make_unique<CpuBackend>(threads);
+#if MMRTM_HAVE_CUDA
+  const CudaDeviceStatus& device = CudaDevice();
+  if (device.available) return std::make_unique<CudaBackend>(backend == Backend::Auto ? threads : -1, note);
+  RequireBackend(backend);
+  static std::atomic<bool> reported{false};
+  if (note && !reported.exchange(true)) note(device.reason + "; rendering on the CPU");
+#else
+  RequireBackend(backend);
+#endif
+  return std::make_unique<CpuBackend>(threads);
+}
+
+}  // namespace mmrtm
