@@ -417,23 +417,30 @@ TEST(VolumeLoader, VolumeTooLargeForMemoryIsRefusedBeforeAllocating) {
   ExpectInputError(path, "of memory available; nothing was allocated");
 }
 
+// Copies the frog label map into a scratch folder with one header line
+// edited; returns the header's path.
+std::string CopyFrogWithHeaderEdit(const std::string& folder, const std::string& from, const std::string& to) {
+  const std::string dir = Scratch(folder);
+  fs::create_directories(dir);
+  fs::copy_file(Data("frogtissue.zraw"), dir + "/frogtissue.zraw");
+  std::ifstream in(Data("frogtissue.mhd"));
+  std::string header((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = header.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) header.replace(at, from.size(), to);
+  std::ofstream(dir + "/frogtissue.mhd") << header;
+  return dir + "/frogtissue.mhd";
+}
+
 // The Whole Frog header once said CompressedDataSize 260020 for a 262087-byte
 // stream, and ITK read garbage into the last slices. Here the whole stream is
 // read and checked, with a warning about the header.
 TEST(VolumeLoader, MetaImageWithWrongCompressedSizeWarnsAndReadsEverything) {
-  const std::string folder = Scratch("frog");
-  fs::create_directories(folder);
-  fs::copy_file(Data("frogtissue.zraw"), folder + "/frogtissue.zraw");
-  std::ifstream in(Data("frogtissue.mhd"));
-  std::string header((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const size_t at = header.find("CompressedDataSize = 262087");
-  ASSERT_NE(at, std::string::npos);
-  header.replace(at, 27, "CompressedDataSize = 260020");
-  std::ofstream(folder + "/frogtissue.mhd") << header;
+  const std::string header = CopyFrogWithHeaderEdit("frog", "CompressedDataSize = 262087", "CompressedDataSize = 260020");
   std::vector<std::string> warnings;
   mmrtm::VolumeLoadOptions options;
   options.warn = [&](const std::string& w) { warnings.push_back(w); };
-  const HostVolume wrong = LoadVolume(folder + "/frogtissue.mhd", "labels", options);
+  const HostVolume wrong = LoadVolume(header, "labels", options);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("CompressedDataSize says 260020 bytes but frogtissue.zraw holds 262087"),
             std::string::npos)
@@ -446,16 +453,7 @@ TEST(VolumeLoader, MetaImageWithWrongCompressedSizeWarnsAndReadsEverything) {
 
 // A MetaImage whose DimSize promises more voxels than its data holds.
 TEST(VolumeLoader, MetaImageWithTooFewVoxelsIsRefused) {
-  const std::string folder = Scratch("frog_dims");
-  fs::create_directories(folder);
-  fs::copy_file(Data("frogtissue.zraw"), folder + "/frogtissue.zraw");
-  std::ifstream in(Data("frogtissue.mhd"));
-  std::string header((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const size_t at = header.find("DimSize = 500 470 136");
-  ASSERT_NE(at, std::string::npos);
-  header.replace(at, 21, "DimSize = 500 470 140");
-  std::ofstream(folder + "/frogtissue.mhd") << header;
-  ExpectInputError(folder + "/frogtissue.mhd", "expected");
+  ExpectInputError(CopyFrogWithHeaderEdit("frog_dims", "DimSize = 500 470 136", "DimSize = 500 470 140"), "expected");
 }
 
 TEST(VolumeLoader, NanVoxelIsRejected) {
