@@ -7,6 +7,7 @@ packages=(
   nlohmann-json3-dev libpng-dev zlib1g-dev libgtest-dev
   libvtk9-dev python3-vtk9
   libinsighttoolkit5-dev   # DICOM through ITK + GDCM (JPEG 2000 included)
+  python3-dev              # the Python wrapping of the VTK module
   xvfb xauth
   invesalius-examples   # the default input: Cranium.inv3
 )

@@ -1,0 +1,170 @@
+#include "mmrtmVtkSceneTranslation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <vtkCamera.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkLight.h>
+#include <vtkLightCollection.h>
+#include <vtkPiecewiseFunction.h>
+#include <vtkRenderer.h>
+#include <vtkVolumeProperty.h>
+
+namespace mmrtm {
+namespace {
+
+// Sample positions over [lo, hi] (one point when the range is empty).
+std::vector<float> Positions(std::array<float, 2> range) {
+  if (!(range[1] > range[0])) return {range[0]};
+  std::vector<float> x(kTableSize);
+  for (int i = 0; i < kTableSize; ++i) x[i] = range[0] + (range[1] - range[0]) * (float)i / (kTableSize - 1);
+  return x;
+}
+
+int AddCurve(Scene& scene, const std::string& where, int proxy, const std::vector<float>& keys,
+             const std::vector<float>& values, int channels) {
+  TransferFunctionDesc tf;
+  tf.where = where;
+  tf.type = TFType::CCTF;
+  tf.proxy = proxy;
+  tf.channels = channels;
+  tf.keys = keys;
+  tf.values = values;
+  scene.tfs.push_back(std::move(tf));
+  return (int)scene.tfs.size() - 1;
+}
+
+bool IsConstantOne(vtkPiecewiseFunction* f) {
+  if (!f || f->GetSize() == 0) return true;
+  double node[4];
+  for (int i = 0; i < f->GetSize(); ++i) {
+    f->GetNodeValue(i, node);
+    if (node[1] != 1.0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool UsesGradientOpacity(vtkVolumeProperty* property, int component) {
+  return property && !property->GetDisableGradientOpacity(component) &&
+         !IsConstantOne(property->GetStoredGradientOpacity(component));
+}
+
+void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, std::array<float, 2> scalarRange,
+                              int gradientProxy, std::array<float, 2> gradientRange, Scene& scene) {
+  scene.tfs.clear();
+  scene.materials.clear();
+  scene.selectors.clear();
+  MaterialDesc m;
+  m.name = "volume";
+  const std::vector<float> x = Positions(scalarRange);
+  const int n = (int)x.size();
+
+  // Extinction from opacity per unit distance.
+  std::vector<float> alpha(n), density(n);
+  vtkPiecewiseFunction* opacity = property->GetScalarOpacity(component);
+  if (n > 1)
+    opacity->GetTable(x.front(), x.back(), n, alpha.data());
+  else
+    alpha[0] = (float)opacity->GetValue(x[0]);
+  const double unit = std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
+  for (int i = 0; i < n; ++i)
+    density[i] = (float)(-std::log(1.0 - std::clamp((double)alpha[i], 0.0, 0.9999)) / unit);
+  m.base[QuantityOffset(Quantity::Density)] = 1.f;
+  m.bindings.push_back({AddCurve(scene, "scalar opacity", 0, x, density, 1), Quantity::Density});
+
+  // Gradient opacity multiplies the extinction.
+  if (gradientProxy >= 0) {
+    const std::vector<float> g = Positions(gradientRange);
+    std::vector<float> gv(g.size());
+    vtkPiecewiseFunction* f = property->GetGradientOpacity(component);
+    for (size_t i = 0; i < g.size(); ++i) gv[i] = (float)std::clamp(f->GetValue(g[i]), 0.0, 1.0);
+    m.bindings.push_back({AddCurve(scene, "gradient opacity", gradientProxy, g, gv, 1), Quantity::Density});
+  }
+
+  // Albedo from colour (grey when the property holds a grey function).
+  std::vector<float> rgb(3 * n);
+  if (property->GetColorChannels(component) == 3) {
+    vtkColorTransferFunction* color = property->GetRGBTransferFunction(component);
+    if (n > 1) {
+      color->GetTable(x.front(), x.back(), n, rgb.data());
+    } else {
+      double c[3];
+      color->GetColor(x[0], c);
+      for (int k = 0; k < 3; ++k) rgb[k] = (float)c[k];
+    }
+  } else {
+    vtkPiecewiseFunction* grey = property->GetGrayTransferFunction(component);
+    for (int i = 0; i < n; ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = (float)grey->GetValue(x[i]);
+  }
+  for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+  m.bindings.push_back({AddCurve(scene, "color", 0, x, rgb, 3), Quantity::Albedo});
+
+  // Shading.
+  const bool shade = property->GetShade(component) != 0;
+  m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
+  const double specular = property->GetSpecular(component), power = std::max(property->GetSpecularPower(component), 0.0);
+  m.base[QuantityOffset(Quantity::Roughness)] =
+      specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
+  m.base[QuantityOffset(Quantity::Metallic)] = 0.f;
+  m.base[QuantityOffset(Quantity::Anisotropy)] = 0.f;
+  scene.materials.push_back(std::move(m));
+  scene.defaultMaterial = 0;
+}
+
+void SetCameraFromVtk(vtkCamera* camera, Scene& scene) {
+  CameraDesc& c = scene.camera;
+  c.autoFrame = false;
+  const double* p = camera->GetPosition();
+  const double* f = camera->GetFocalPoint();
+  const double* u = camera->GetViewUp();
+  c.position = {(float)p[0], (float)p[1], (float)p[2]};
+  c.lookAt = {(float)f[0], (float)f[1], (float)f[2]};
+  c.up = {(float)u[0], (float)u[1], (float)u[2]};
+  c.lensRadius = 0.f;
+  if (camera->GetParallelProjection()) {
+    c.projection = Projection::Orthographic;
+    c.orthoHeight = (float)(2.0 * camera->GetParallelScale());
+  } else {
+    c.projection = Projection::Perspective;
+    c.fovY = (float)camera->GetViewAngle();
+  }
+}
+
+void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene& scene) {
+  scene.lights.clear();
+  scene.cameraLights.clear();
+  vtkLightCollection* lights = renderer->GetLights();
+  lights->InitTraversal();
+  while (vtkLight* light = lights->GetNextItem()) {
+    if (!light->GetSwitch() || light->GetIntensity() <= 0.0) continue;
+    double p[3], f[3];
+    light->GetTransformedPosition(p);
+    light->GetTransformedFocalPoint(f);
+    const Vec3 position{(float)p[0], (float)p[1], (float)p[2]}, focal{(float)f[0], (float)f[1], (float)f[2]};
+    const Vec3 toLight = position - focal;
+    const float distance = Length(toLight);
+    if (!(distance > 0.f)) continue;
+    const double* col = light->GetDiffuseColor();
+    const float scale = kPi * (float)light->GetIntensity();
+    Light l;
+    l.L = RGB((float)col[0] * scale, (float)col[1] * scale, (float)col[2] * scale);
+    if (light->GetPositional()) {
+      l.type = LightType::Point;
+      l.vector = position;
+      l.L = l.L * (distance * distance);  // irradiance pi * intensity at the focal point
+    } else {
+      l.type = LightType::Directional;
+      l.vector = toLight / distance;
+    }
+    scene.lights.push_back(l);
+  }
+  const float ambient = (float)property->GetAmbient(0);
+  scene.environment = ambient > 0.f ? EnvironmentMap::Constant(RGB(ambient, ambient, ambient)) : nullptr;
+}
+
+}  // namespace mmrtm

@@ -1,0 +1,56 @@
+// PRIVATE to MMRTM::Rendering: VTK's description of a volume rendering
+// (vtkVolumeProperty, vtkCamera, vtkLight) translated into the tracer's
+// Scene. The rules, which Documentation/vtk-mapper.md states for users:
+//
+// - Scalar opacity alpha(x) per ScalarOpacityUnitDistance d becomes the
+//   extinction sigma_t(x) = -ln(1 - alpha(x)) / d, so that a slab of
+//   thickness d lets 1 - alpha through, as in VTK's compositing.
+// - Colour becomes the albedo; gradient opacity g(|grad x|) multiplies
+//   sigma_t through a gradient-magnitude proxy (made only when used).
+// - The functions are sampled at kTableSize points over the scalar range, as
+//   VTK's own GPU mapper samples them into tables, which keeps midpoints,
+//   sharpness and log scales.
+// - Shade off: volume scattering only (isotropic phase). Shade on: surface
+//   scattering with probability kShadedSurfaceProbability on the gradient
+//   normal; roughness sqrt(2 / (SpecularPower + 2)) (the Blinn-Phong
+//   exponent's GGX equivalent), 1 when Specular is 0. Ambient is a constant
+//   environment light of that radiance. Diffuse is not used: the albedo is
+//   the colour.
+// - Lights: a directional light (scene light, headlight, camera light)
+//   gives irradiance pi * intensity * colour, so that a white Lambertian
+//   surface facing it shows intensity * colour, as VTK's diffuse shading
+//   does; a positional light gives the same irradiance at its focal point.
+#pragma once
+
+#include <array>
+
+#include "scene.h"
+
+class vtkCamera;
+class vtkRenderer;
+class vtkVolumeProperty;
+
+namespace mmrtm {
+
+constexpr int kTableSize = 256;
+constexpr float kShadedSurfaceProbability = 0.8f;
+
+// Whether component `component`'s gradient opacity is in use (enabled and
+// not constant 1), so that the gradient-magnitude proxy is needed.
+bool UsesGradientOpacity(vtkVolumeProperty* property, int component);
+
+// Replaces the scene's TFs, materials and selectors with those of the
+// property's component `component`. `scalarRange` is the data's value range;
+// `gradientProxy` is the index of the gradient-magnitude proxy (or -1) and
+// `gradientRange` its value range.
+void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, std::array<float, 2> scalarRange,
+                              int gradientProxy, std::array<float, 2> gradientRange, Scene& scene);
+
+// Sets the scene's camera from VTK's.
+void SetCameraFromVtk(vtkCamera* camera, Scene& scene);
+
+// Replaces the scene's lights with the renderer's lights that are on, and
+// the environment with the property's ambient term.
+void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene& scene);
+
+}  // namespace mmrtm

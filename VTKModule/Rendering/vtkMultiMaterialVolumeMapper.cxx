@@ -1,0 +1,305 @@
+#include "vtkMultiMaterialVolumeMapper.h"
+
+#include <algorithm>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include <vtkCamera.h>
+#include <vtkDataArray.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkImageData.h>
+#include <vtkLight.h>
+#include <vtkLightCollection.h>
+#include <vtkMatrix4x4.h>
+#include <vtkObjectFactory.h>
+#include <vtkPiecewiseFunction.h>
+#include <vtkRayCastImageDisplayHelper.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkVolume.h>
+#include <vtkVolumeProperty.h>
+
+#include "derived_proxies.h"
+#include "film.h"
+#include "mmrtmImageDataConversion.h"
+#include "mmrtmVtkSceneTranslation.h"
+#include "render_backend.h"
+#include "scene.h"
+
+vtkStandardNewMacro(vtkMultiMaterialVolumeMapper);
+
+// What the mapper keeps between renders, and the modification times that
+// decide how much of it a render must redo.
+struct vtkMultiMaterialVolumeMapper::Internals
+{
+  mmrtm::Scene Scene;
+  std::unique_ptr<mmrtm::Renderer> Renderer;
+  int RendererBackend = -1, RendererThreads = -1;
+  std::unique_ptr<mmrtm::Film> Film;
+  std::string BackendDescription;
+  vtkNew<vtkMatrix4x4> Matrix;  // the volume's matrix at the last render
+
+  // Index-to-world of each proxy before the volume's matrix.
+  std::vector<mmrtm::Affine3> ImageIndexToWorld;
+  std::array<float, 2> ScalarRange{ 0.f, 0.f }, GradientRange{ 0.f, 0.f };
+  int GradientProxy = -1;
+
+  vtkDataObject* Data = nullptr;
+  vtkMTimeType DataTime = 0, PropertyTime = 0, ViewTime = 0;
+  bool HasScene = false, Warned = false;
+
+  int SceneBuilds = 0, Refits = 0, Restarts = 0;
+};
+
+namespace
+{
+// The latest modification among the property and its component-0 functions
+// (editing a function does not touch the property's own MTime).
+vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
+{
+  vtkMTimeType t = p->GetMTime();
+  t = std::max(t, p->GetScalarOpacity(0)->GetMTime());
+  t = std::max(t, p->GetGradientOpacity(0)->GetMTime());
+  if (p->GetColorChannels(0) == 3)
+    t = std::max(t, p->GetRGBTransferFunction(0)->GetMTime());
+  else
+    t = std::max(t, p->GetGrayTransferFunction(0)->GetMTime());
+  return t;
+}
+
+// Camera, lights, the volume's matrix: a change restarts the accumulation.
+vtkMTimeType ViewMTime(vtkRenderer* ren, vtkVolume* vol)
+{
+  vtkMTimeType t = ren->GetActiveCamera()->GetMTime();
+  t = std::max(t, vol->GetMTime());
+  if (vtkMatrix4x4* m = vol->GetUserMatrix())
+    t = std::max(t, m->GetMTime());
+  vtkLightCollection* lights = ren->GetLights();
+  lights->InitTraversal();
+  while (vtkLight* l = lights->GetNextItem())
+    t = std::max(t, l->GetMTime());
+  return t;
+}
+
+mmrtm::Affine3 ToAffine(vtkMatrix4x4* m)
+{
+  mmrtm::Affine3 a;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c)
+      a.m[r][c] = static_cast<float>(m->GetElement(r, c));
+  return a;
+}
+}
+
+vtkMultiMaterialVolumeMapper::vtkMultiMaterialVolumeMapper()
+  : Internal(new Internals)
+{
+}
+
+vtkMultiMaterialVolumeMapper::~vtkMultiMaterialVolumeMapper() = default;
+
+void vtkMultiMaterialVolumeMapper::ResetAccumulation()
+{
+  if (this->Internal->Film)
+    this->Internal->Film->Reset();
+}
+
+int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
+{
+  return this->Internal->Film ? static_cast<int>(this->Internal->Film->Samples()) : 0;
+}
+
+int vtkMultiMaterialVolumeMapper::GetNumberOfSceneBuilds()
+{
+  return this->Internal->SceneBuilds;
+}
+
+int vtkMultiMaterialVolumeMapper::GetNumberOfRefits()
+{
+  return this->Internal->Refits;
+}
+
+int vtkMultiMaterialVolumeMapper::GetNumberOfRestarts()
+{
+  return this->Internal->Restarts;
+}
+
+const char* vtkMultiMaterialVolumeMapper::GetBackendDescription()
+{
+  return this->Internal->BackendDescription.c_str();
+}
+
+void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  Internals& in = *this->Internal;
+  vtkImageData* input = vtkImageData::SafeDownCast(this->GetInput());
+  vtkVolumeProperty* property = vol->GetProperty();
+  if (!input || !property)
+  {
+    vtkErrorMacro("Render: no input image or no volume property");
+    return;
+  }
+  if (!in.Warned && (this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND || this->Cropping))
+  {
+    vtkWarningMacro("only composite blending without cropping is supported; rendering as composite");
+    in.Warned = true;
+  }
+
+  int width = 0, height = 0, originX = 0, originY = 0;
+  ren->GetTiledSizeAndOrigin(&width, &height, &originX, &originY);
+  if (width <= 0 || height <= 0)
+    return;
+
+  try
+  {
+    // Data: a new or modified input rebuilds the proxies and the grid's summaries.
+    this->GetInputAlgorithm()->UpdateInformation();
+    this->GetInputAlgorithm()->Update();
+    input = vtkImageData::SafeDownCast(this->GetInput());
+    if (!input)
+      throw mmrtm::InputError("the input is not a vtkImageData");
+    bool restart = false;
+    if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene)
+    {
+      in.Scene.proxies.clear();
+      in.ImageIndexToWorld.clear();
+      int cellFlag = 0;
+      vtkDataArray* scalars = vtkAbstractMapper::GetScalars(input, this->ScalarMode, this->ArrayAccessMode,
+        this->ArrayId, this->ArrayName, cellFlag);
+      if (cellFlag)
+        throw mmrtm::InputError("cell scalars are not supported; give point scalars");
+      in.Scene.proxies.push_back(mmrtm::ImageDataToHostVolume(
+        input, scalars, 0, "scalars", mmrtm::Interpolation::Trilinear));
+      in.ScalarRange = in.Scene.proxies[0].ValueRange();
+      in.GradientProxy = -1;
+      if (mmrtm::UsesGradientOpacity(property, 0))
+      {
+        in.Scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(in.Scene.proxies[0], "gradient"));
+        in.GradientProxy = 1;
+        in.GradientRange = in.Scene.proxies[1].ValueRange();
+      }
+      for (const mmrtm::HostVolume& v : in.Scene.proxies)
+        in.ImageIndexToWorld.push_back(v.indexToWorld);
+      in.Scene.MarkDataModified();
+      in.Data = input;
+      in.DataTime = input->GetMTime();
+      in.PropertyTime = 0;  // translate the property again
+      ++in.SceneBuilds;
+      restart = true;
+    }
+
+    // Transfer functions: translated again and refitted.
+    const vtkMTimeType propertyTime = PropertyMTime(property);
+    if (propertyTime != in.PropertyTime)
+    {
+      if (mmrtm::UsesGradientOpacity(property, 0) != (in.GradientProxy >= 0))
+      {
+        in.HasScene = false;  // the gradient proxy comes or goes: a data rebuild
+        this->Render(ren, vol);
+        return;
+      }
+      mmrtm::SetMaterialsFromProperty(
+        property, 0, in.ScalarRange, in.GradientProxy, in.GradientRange, in.Scene);
+      in.PropertyTime = propertyTime;
+      ++in.Refits;
+      restart = true;
+    }
+
+    // View: camera, lights, matrix, viewport, and the mapper's own settings.
+    const vtkMTimeType viewTime = std::max(ViewMTime(ren, vol), this->GetMTime());
+    if (viewTime != in.ViewTime || !in.Film || in.Film->Width() != width || in.Film->Height() != height)
+    {
+      in.ViewTime = viewTime;
+      restart = true;
+    }
+
+    if (restart)
+    {
+      vol->GetMatrix(in.Matrix);
+      const mmrtm::Affine3 propMatrix = ToAffine(in.Matrix);
+      for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
+        in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
+      mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
+      mmrtm::SetLightsFromVtk(ren, property, in.Scene);
+      mmrtm::RenderSettings& rs = in.Scene.render;
+      rs.width = width;
+      rs.height = height;
+      rs.threads = this->NumberOfThreads;
+      rs.exposure = static_cast<float>(this->Exposure);
+      rs.integrator.seed = static_cast<uint64_t>(this->Seed);
+      rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
+      rs.integrator.backgroundVisible = false;  // VTK's background shows through
+      in.Film = std::make_unique<mmrtm::Film>(width, height);
+      in.HasScene = true;
+      ++in.Restarts;
+    }
+    const mmrtm::SceneView view = in.Scene.Build();
+
+    if (!in.Renderer || in.RendererBackend != this->Backend || in.RendererThreads != this->NumberOfThreads)
+    {
+      const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
+        : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
+                                                          : mmrtm::Backend::Auto;
+      in.Renderer = mmrtm::MakeRenderer(backend, this->NumberOfThreads,
+        [this](const std::string& note) { vtkDebugMacro(<< note); });
+      in.RendererBackend = this->Backend;
+      in.RendererThreads = this->NumberOfThreads;
+      in.BackendDescription = in.Renderer->Description();
+    }
+    const int accumulated = static_cast<int>(in.Film->Samples());
+    const int samples = this->MaximumSamples > 0
+      ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
+      : this->SamplesPerRender;
+    if (samples > 0)
+      in.Renderer->Render(in.Scene, view, *in.Film, samples, nullptr, nullptr);
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro("Render: " << e.what());
+    return;
+  }
+
+  // The image: tone-mapped, premultiplied RGBA, bottom row first for OpenGL.
+  std::vector<uint8_t> rgba =
+    in.Film->ToneMapped(static_cast<float>(this->Exposure), in.Scene.render.toneMapper, 4);
+  const size_t row = 4 * static_cast<size_t>(width);
+  for (int y = 0; y < height / 2; ++y)
+    std::swap_ranges(rgba.begin() + y * row, rgba.begin() + (y + 1) * row, rgba.begin() + (height - 1 - y) * row);
+
+  // Drawn at the depth of the volume's nearest bounding-box corner.
+  double bounds[6];
+  vol->GetBounds(bounds);
+  double depth = 1.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    ren->SetWorldPoint(bounds[corner & 1], bounds[2 + ((corner >> 1) & 1)], bounds[4 + ((corner >> 2) & 1)], 1.0);
+    ren->WorldToDisplay();
+    depth = std::min(depth, ren->GetDisplayPoint()[2]);
+  }
+  depth = std::clamp(depth, 1e-6, 1.0);
+
+  vtkNew<vtkRayCastImageDisplayHelper> helper;  // the OpenGL one, through the object factory
+  helper->PreMultipliedColorsOn();
+  int size[2] = { width, height }, origin[2] = { 0, 0 };
+  helper->RenderTexture(vol, ren, size, size, size, origin, static_cast<float>(depth), rgba.data());
+  helper->ReleaseGraphicsResources(ren->GetRenderWindow());
+}
+
+void vtkMultiMaterialVolumeMapper::ReleaseGraphicsResources(vtkWindow*)
+{
+  // Textures are made and released within each Render.
+}
+
+void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "SamplesPerRender: " << this->SamplesPerRender << "\n";
+  os << indent << "MaximumSamples: " << this->MaximumSamples << "\n";
+  os << indent << "Seed: " << this->Seed << "\n";
+  os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Backend: " << this->Backend << "\n";
+  os << indent << "Exposure: " << this->Exposure << "\n";
+  os << indent << "ShadowExtinctionScale: " << this->ShadowExtinctionScale << "\n";
+  os << indent << "AccumulatedSamples: " << (this->Internal->Film ? this->Internal->Film->Samples() : 0) << "\n";
+}

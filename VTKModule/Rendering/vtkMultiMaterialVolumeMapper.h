@@ -1,0 +1,167 @@
+/**
+ * @class   vtkMultiMaterialVolumeMapper
+ * @brief   physically based volume rendering with the MM-RTM path tracer
+ *
+ * vtkMultiMaterialVolumeMapper renders a vtkImageData with the multi-material
+ * radiative transfer model of Xu et al. 2025: an unbiased volumetric path
+ * tracer (delta tracking, multiple scattering, surface scattering on the
+ * gradient normal) accelerated by a hierarchical majorant grid. It maps the
+ * vtkVolumeProperty of the volume onto the tracer's transfer functions by
+ * the rules of Documentation/vtk-mapper.md, takes its lights from the
+ * renderer, and accumulates samples progressively: every Render() adds
+ * SamplesPerRender samples per pixel until MaximumSamples, and any change
+ * restarts the accumulation with the least work that change needs:
+ *
+ * - new or modified input data: the scene and the majorant grid's summaries
+ *   are rebuilt (GetNumberOfSceneBuilds());
+ * - a change of the volume property or of one of its transfer functions: the
+ *   transfer functions are translated again and the grid refitted
+ *   (GetNumberOfRefits());
+ * - a change of the camera, a light, the viewport or the volume's matrix:
+ *   the accumulation restarts (GetNumberOfRestarts());
+ * - nothing changed: samples are added.
+ *
+ * The volume's matrix (vtkProp3D) is honoured, so oblique orientations and
+ * non-uniform scales render correctly. The image is composited premultiplied
+ * at the depth of the volume's nearest bounding-box corner.
+ *
+ * Not supported yet (a warning is given once): blend modes other than
+ * composite, cropping, clipping planes, label maps (mask input), more than
+ * one component.
+ *
+ * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
+ */
+#ifndef vtkMultiMaterialVolumeMapper_h
+#define vtkMultiMaterialVolumeMapper_h
+
+#include "mmrtmRenderingModule.h"  // for export macro
+#include "vtkVolumeMapper.h"
+
+#include <memory>  // for std::unique_ptr
+
+class vtkRayCastImageDisplayHelper;
+
+class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper
+{
+public:
+  static vtkMultiMaterialVolumeMapper* New();
+  vtkTypeMacro(vtkMultiMaterialVolumeMapper, vtkVolumeMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * Samples per pixel added by each Render() (default 4).
+   */
+  vtkSetClampMacro(SamplesPerRender, int, 1, 65536);
+  vtkGetMacro(SamplesPerRender, int);
+  ///@}
+
+  ///@{
+  /**
+   * Samples per pixel after which Render() only redraws the image
+   * (default 256; 0 accumulates without limit).
+   */
+  vtkSetClampMacro(MaximumSamples, int, 0, VTK_INT_MAX);
+  vtkGetMacro(MaximumSamples, int);
+  ///@}
+
+  ///@{
+  /**
+   * Seed of the random numbers (default 0). Renders of one seed and sample
+   * count are identical at any thread count.
+   */
+  vtkSetMacro(Seed, int);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /**
+   * CPU threads, 0 for all (default 0).
+   */
+  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
+  enum Backends
+  {
+    AUTO = 0,
+    CPU = 1,
+    CUDA = 2
+  };
+  ///@{
+  /**
+   * AUTO (default) uses CUDA when a device is present, else the CPU.
+   */
+  vtkSetClampMacro(Backend, int, AUTO, CUDA);
+  vtkGetMacro(Backend, int);
+  void SetBackendToAuto() { this->SetBackend(AUTO); }
+  void SetBackendToCPU() { this->SetBackend(CPU); }
+  void SetBackendToCUDA() { this->SetBackend(CUDA); }
+  ///@}
+
+  ///@{
+  /**
+   * Exposure multiplier before tone mapping (default 1).
+   */
+  vtkSetClampMacro(Exposure, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(Exposure, double);
+  ///@}
+
+  ///@{
+  /**
+   * Shadow-ray extinction scale in (0, 1] (default 0.8, the paper's; 1 is
+   * unbiased).
+   */
+  vtkSetClampMacro(ShadowExtinctionScale, double, 0.01, 1.0);
+  vtkGetMacro(ShadowExtinctionScale, double);
+  ///@}
+
+  /**
+   * Discards the accumulated samples; the next Render() starts again.
+   */
+  void ResetAccumulation();
+
+  /**
+   * Samples per pixel accumulated so far.
+   */
+  int GetAccumulatedSamples();
+
+  ///@{
+  /**
+   * How often the scene was rebuilt (data), refitted (transfer functions)
+   * and the accumulation restarted (any change), since construction.
+   */
+  int GetNumberOfSceneBuilds();
+  int GetNumberOfRefits();
+  int GetNumberOfRestarts();
+  ///@}
+
+  /**
+   * Description of the backend in use ("cpu, 2 thread(s)"), after a render.
+   */
+  const char* GetBackendDescription();
+
+  void Render(vtkRenderer* ren, vtkVolume* vol) override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+
+protected:
+  vtkMultiMaterialVolumeMapper();
+  ~vtkMultiMaterialVolumeMapper() override;
+
+  int SamplesPerRender = 4;
+  int MaximumSamples = 256;
+  int Seed = 0;
+  int NumberOfThreads = 0;
+  int Backend = AUTO;
+  double Exposure = 1.0;
+  double ShadowExtinctionScale = 0.8;
+
+private:
+  vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
+  void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif
