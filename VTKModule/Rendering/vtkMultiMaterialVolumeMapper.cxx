@@ -1,6 +1,7 @@
 #include "vtkMultiMaterialVolumeMapper.h"
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 #include <string>
 #include <vector>
@@ -46,7 +47,8 @@ struct vtkMultiMaterialVolumeMapper::Internals
   int GradientProxy = -1;
 
   vtkDataObject* Data = nullptr;
-  vtkMTimeType DataTime = 0, PropertyTime = 0, ViewTime = 0;
+  vtkMTimeType DataTime = 0, PropertyTime = 0, MapperTime = 0;
+  std::vector<double> View;
   bool HasScene = false, Warned = false;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0;
@@ -68,18 +70,51 @@ vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
   return t;
 }
 
-// Camera, lights, the volume's matrix: a change restarts the accumulation.
-vtkMTimeType ViewMTime(vtkRenderer* ren, vtkVolume* vol)
+// Camera, lights, the volume's matrix and the viewport, as values: a change
+// restarts the accumulation. Values rather than modification times, because
+// VTK swaps in near copies (vtkWindowToImageFilter renders with a copy of
+// the camera whose view angle is off by 1e-8): a screenshot must not restart.
+std::vector<double> ViewSignature(vtkRenderer* ren, vtkVolume* vol, int width, int height)
 {
-  vtkMTimeType t = ren->GetActiveCamera()->GetMTime();
-  t = std::max(t, vol->GetMTime());
-  if (vtkMatrix4x4* m = vol->GetUserMatrix())
-    t = std::max(t, m->GetMTime());
+  std::vector<double> v{ static_cast<double>(width), static_cast<double>(height) };
+  auto add = [&v](const double* p, int n) { v.insert(v.end(), p, p + n); };
+  vtkCamera* cam = ren->GetActiveCamera();
+  add(cam->GetPosition(), 3);
+  add(cam->GetFocalPoint(), 3);
+  add(cam->GetViewUp(), 3);
+  v.push_back(cam->GetViewAngle());
+  v.push_back(cam->GetParallelProjection());
+  v.push_back(cam->GetParallelScale());
+  vtkNew<vtkMatrix4x4> m;
+  vol->GetMatrix(m);
+  add(&m->Element[0][0], 16);
   vtkLightCollection* lights = ren->GetLights();
   lights->InitTraversal();
   while (vtkLight* l = lights->GetNextItem())
-    t = std::max(t, l->GetMTime());
-  return t;
+  {
+    double p[3], f[3];
+    l->GetTransformedPosition(p);
+    l->GetTransformedFocalPoint(f);
+    add(p, 3);
+    add(f, 3);
+    add(l->GetDiffuseColor(), 3);
+    v.push_back(l->GetIntensity());
+    v.push_back(l->GetSwitch());
+    v.push_back(l->GetPositional());
+  }
+  return v;
+}
+
+// Equal to a relative 1e-6: vtkWindowToImageFilter renders with a camera
+// whose view angle went through tan and atan.
+bool SameView(const std::vector<double>& a, const std::vector<double>& b)
+{
+  if (a.size() != b.size())
+    return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::abs(a[i] - b[i]) > 1e-6 * std::max({ 1.0, std::abs(a[i]), std::abs(b[i]) }))
+      return false;
+  return true;
 }
 
 mmrtm::Affine3 ToAffine(vtkMatrix4x4* m)
@@ -206,11 +241,12 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       restart = true;
     }
 
-    // View: camera, lights, matrix, viewport, and the mapper's own settings.
-    const vtkMTimeType viewTime = std::max(ViewMTime(ren, vol), this->GetMTime());
-    if (viewTime != in.ViewTime || !in.Film || in.Film->Width() != width || in.Film->Height() != height)
+    // View: camera, lights, matrix, viewport (by value), and the mapper's own settings.
+    std::vector<double> view = ViewSignature(ren, vol, width, height);
+    if (!SameView(view, in.View) || this->GetMTime() != in.MapperTime || !in.Film)
     {
-      in.ViewTime = viewTime;
+      in.View = std::move(view);
+      in.MapperTime = this->GetMTime();
       restart = true;
     }
 
@@ -234,7 +270,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.HasScene = true;
       ++in.Restarts;
     }
-    const mmrtm::SceneView view = in.Scene.Build();
+    const mmrtm::SceneView sceneView = in.Scene.Build();
 
     if (!in.Renderer || in.RendererBackend != this->Backend || in.RendererThreads != this->NumberOfThreads)
     {
@@ -252,7 +288,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
       : this->SamplesPerRender;
     if (samples > 0)
-      in.Renderer->Render(in.Scene, view, *in.Film, samples, nullptr, nullptr);
+      in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
   }
   catch (const std::exception& e)
   {

@@ -1,0 +1,158 @@
+"""vtkMultiMaterialVolumeMapper driven from Python as a ParaView-style script
+would: build a pipeline and render; change nothing and the samples
+accumulate; change a transfer function, the camera or the data and the
+mapper redoes exactly the work that change needs (counted by the mapper).
+
+Run by ctest under xvfb-run with /usr/bin/python3 (python3-vtk9) and the
+build tree's mmrtm package on PYTHONPATH.
+"""
+import os
+import unittest
+
+from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
+from vtkmodules.vtkImagingCore import vtkImageShiftScale
+from vtkmodules.vtkIOImage import vtkNrrdReader
+from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
+                                         vtkVolumeProperty, vtkWindowToImageFilter)
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
+import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
+
+from mmrtm import vtkMultiMaterialVolumeMapper
+
+DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
+BACKGROUND = (0.1, 0.1, 0.15)
+
+
+class Scene:
+    """A head CT (64 x 64 x 93) with a bone transfer function, 128 x 128."""
+
+    def __init__(self):
+        self.reader = vtkNrrdReader()
+        self.reader.SetFileName(os.path.join(DATA, "ct_head_headsq.nrrd"))
+        self.shift = vtkImageShiftScale()  # a pipeline stage whose change is a data change
+        self.shift.SetInputConnection(self.reader.GetOutputPort())
+        self.mapper = vtkMultiMaterialVolumeMapper()
+        self.mapper.SetInputConnection(self.shift.GetOutputPort())
+        self.mapper.SetSamplesPerRender(2)
+        self.mapper.SetMaximumSamples(8)
+        self.mapper.SetSeed(3)
+        self.mapper.SetBackendToCPU()
+        self.opacity = vtkPiecewiseFunction()
+        self.opacity.AddPoint(1100, 0.0)
+        self.opacity.AddPoint(2000, 0.8)
+        self.color = vtkColorTransferFunction()
+        self.color.AddRGBPoint(1100, 0.9, 0.6, 0.5)
+        self.color.AddRGBPoint(2000, 1.0, 0.95, 0.9)
+        self.property = vtkVolumeProperty()
+        self.property.SetScalarOpacity(self.opacity)
+        self.property.SetColor(self.color)
+        self.property.ShadeOn()
+        self.property.SetAmbient(0.3)
+        self.volume = vtkVolume()
+        self.volume.SetMapper(self.mapper)
+        self.volume.SetProperty(self.property)
+        self.renderer = vtkRenderer()
+        self.renderer.AddVolume(self.volume)
+        self.renderer.SetBackground(*BACKGROUND)
+        self.window = vtkRenderWindow()
+        self.window.SetOffScreenRendering(1)
+        self.window.AddRenderer(self.renderer)
+        self.window.SetSize(128, 128)
+        self.renderer.ResetCamera()
+        self.renderer.GetActiveCamera().Elevation(-80)
+        self.renderer.GetActiveCamera().OrthogonalizeViewUp()
+
+    def render(self):
+        self.window.Render()
+
+    def counts(self):
+        m = self.mapper
+        return m.GetNumberOfSceneBuilds(), m.GetNumberOfRefits(), m.GetNumberOfRestarts()
+
+    def pixels(self):
+        grab = vtkWindowToImageFilter()
+        grab.SetInput(self.window)
+        grab.ReadFrontBufferOff()
+        grab.Update()
+        a = grab.GetOutput().GetPointData().GetScalars()
+        n = a.GetNumberOfComponents()
+        return [a.GetValue(i) for i in range(a.GetNumberOfTuples() * n) if i % n < 3]
+
+
+def mean_abs_difference(a, b):
+    return sum(abs(x - y) for x, y in zip(a, b)) / len(a) / 255.0
+
+
+def coverage(pixels):
+    covered = 0
+    for i in range(0, len(pixels), 3):
+        if max(abs(pixels[i + c] / 255.0 - BACKGROUND[c]) for c in range(3)) > 0.08:
+            covered += 1
+    return covered / (len(pixels) / 3)
+
+
+class MapperTest(unittest.TestCase):
+    def test_renders_something(self):
+        s = Scene()
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+        self.assertTrue(s.mapper.GetBackendDescription().startswith("cpu"))
+        c = coverage(s.pixels())
+        self.assertGreater(c, 0.05, "the volume covers almost nothing: a black or empty image")
+        self.assertLess(c, 0.9)
+
+    def test_unchanged_scene_accumulates_up_to_the_maximum(self):
+        s = Scene()
+        samples = []
+        for _ in range(6):
+            s.render()
+            samples.append(s.mapper.GetAccumulatedSamples())
+        self.assertEqual(samples, [2, 4, 6, 8, 8, 8])
+        self.assertEqual(s.counts(), (1, 1, 1), "nothing changed: no rebuild, refit or restart")
+        s.pixels()  # a screenshot renders with a copy of the camera: no restart
+        self.assertEqual(s.counts(), (1, 1, 1))
+        s.mapper.ResetAccumulation()
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+
+    def test_transfer_function_change_refits_and_restarts(self):
+        s = Scene()
+        for _ in range(3):
+            s.render()
+        before = s.pixels()
+        # Editing a function does not change the property's own MTime; the
+        # mapper must notice anyway.
+        s.opacity.AddPoint(1500, 0.0)
+        s.color.AddRGBPoint(2000, 0.2, 0.4, 1.0)
+        s.render()
+        self.assertEqual(s.counts(), (1, 2, 2))
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+        self.assertGreater(mean_abs_difference(before, s.pixels()), 0.005, "the image did not change")
+
+    def test_camera_change_restarts_only(self):
+        s = Scene()
+        s.render()
+        s.render()
+        s.renderer.GetActiveCamera().Azimuth(20)
+        s.render()
+        self.assertEqual(s.counts(), (1, 1, 2))
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+
+    def test_data_change_rebuilds(self):
+        s = Scene()
+        s.render()
+        s.shift.SetShift(200.0)  # every value +200: the bone grows
+        s.render()
+        self.assertEqual(s.counts(), (2, 2, 2))
+        s.render()
+        self.assertEqual(s.counts(), (2, 2, 2))
+
+    def test_same_seed_same_image(self):
+        a, b = Scene(), Scene()
+        a.render()
+        b.render()
+        self.assertEqual(a.pixels(), b.pixels())
+
+
+if __name__ == "__main__":
+    unittest.main()
