@@ -7,11 +7,14 @@ Run by ctest under xvfb-run with /usr/bin/python3 (python3-vtk9) and the
 build tree's mmrtm package on PYTHONPATH.
 """
 import os
+import subprocess
+import sys
+import tempfile
 import unittest
 
 from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
 from vtkmodules.vtkImagingCore import vtkImageShiftScale
-from vtkmodules.vtkIOImage import vtkNrrdReader
+from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
 from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
                                          vtkVolumeProperty, vtkWindowToImageFilter)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
@@ -152,6 +155,26 @@ class MapperTest(unittest.TestCase):
         a.render()
         b.render()
         self.assertEqual(a.pixels(), b.pixels())
+
+
+class ExampleTest(unittest.TestCase):
+    def test_dicom_example_renders_the_chest(self):
+        example = os.path.join(os.path.dirname(__file__), "..", "..", "Documentation", "examples",
+                               "render_dicom_ct.py")
+        with tempfile.TemporaryDirectory() as tmp:
+            png = os.path.join(tmp, "chest.png")
+            r = subprocess.run([sys.executable, example, os.path.join(DATA, "ct_chest_dicom"), png],
+                               capture_output=True, text=True, timeout=600)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            reader = vtkPNGReader()
+            reader.SetFileName(png)
+            reader.Update()
+            a = reader.GetOutput().GetPointData().GetScalars()
+            n = a.GetNumberOfComponents()
+            lit = sum(1 for i in range(a.GetNumberOfTuples()) if max(a.GetValue(i * n + c) for c in range(3)) > 40)
+            fraction = lit / a.GetNumberOfTuples()
+            self.assertGreater(fraction, 0.1, "the ribcage should cover part of the image")
+            self.assertLess(fraction, 0.9)
 
 
 if __name__ == "__main__":
