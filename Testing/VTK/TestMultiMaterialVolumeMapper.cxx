@@ -5,10 +5,12 @@
 //
 //   TestMultiMaterialVolumeMapper CASE -D DATA_DIR -V BASELINE.png -T TEMP_DIR
 //
-// CASE: "ct-bone" (a head CT with a bone transfer function) or "oblique"
-// (the same volume turned and stretched by the vtkVolume's matrix).
+// CASE: "ct-bone" (a head CT with a bone transfer function), "oblique"
+// (the same volume turned and stretched by the vtkVolume's matrix) or
+// "labels" (a CT angiography whose vessel label map gives per-label colours
+// and opacities through SetMaskInput and the property's label functions).
 //
-// Before the comparison, the same scene is rendered with VTK's own
+// Before the comparison, the ct-bone and oblique scenes are rendered with VTK's own
 // vtkFixedPointVolumeRayCastMapper: the pixels the volume covers must be
 // nearly the same (intersection over union), which checks the camera, the
 // volume's geometry and matrix, and the depth of the composited image
@@ -25,6 +27,7 @@
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkFixedPointVolumeRayCastMapper.h>
+#include <vtkNIFTIImageReader.h>
 #include <vtkNrrdReader.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
@@ -75,8 +78,13 @@ int main(int argc, char* argv[])
   testing->AddArguments(argc, const_cast<const char**>(argv));
   const std::string data = testing->GetDataRoot() ? testing->GetDataRoot() : ".";
 
-  vtkNew<vtkNrrdReader> reader;
-  reader->SetFileName((data + "/ct_head_headsq.nrrd").c_str());
+  const bool labels = testCase == "labels";
+  vtkNew<vtkNrrdReader> nrrd;
+  nrrd->SetFileName((data + "/ct_head_headsq.nrrd").c_str());
+  vtkNew<vtkNIFTIImageReader> angio, vessels;
+  angio->SetFileName((data + "/cta_chest_aorta.nii.gz").c_str());
+  vessels->SetFileName((data + "/cta_chest_aorta_labels.nii.gz").c_str());
+  vtkAlgorithm* reader = labels ? static_cast<vtkAlgorithm*>(angio) : nrrd;
 
   vtkNew<vtkMultiMaterialVolumeMapper> mapper;
   mapper->SetInputConnection(reader->GetOutputPort());
@@ -101,6 +109,29 @@ int main(int argc, char* argv[])
   property->ShadeOn();
   property->SetAmbient(0.3);
 
+  if (labels)
+  {
+    // Hounsfield units: faint bone for context; labels 1-6 (arteries) red,
+    // 7 (a vertebra) ivory, opaque wherever the label is.
+    opacity->RemoveAllPoints();
+    opacity->AddPoint(200, 0.0);
+    opacity->AddPoint(600, 0.05);
+    opacity->AddPoint(1500, 0.15);
+    vessels->Update();
+    mapper->SetMaskInput(vessels->GetOutput());
+    mapper->SetMaskTypeToLabelMap();
+    vtkNew<vtkPiecewiseFunction> solid;
+    solid->AddPoint(-1000, 0.9);
+    solid->AddPoint(3000, 0.9);
+    vtkNew<vtkColorTransferFunction> red, ivory;
+    red->AddRGBPoint(-1000, 0.85, 0.12, 0.1);
+    ivory->AddRGBPoint(-1000, 0.93, 0.88, 0.78);
+    for (int label = 1; label <= 7; ++label)
+    {
+      property->SetLabelScalarOpacity(label, solid);
+      property->SetLabelColor(label, label == 7 ? ivory.Get() : red.Get());
+    }
+  }
   vtkNew<vtkVolume> volume;
   volume->SetMapper(mapper);
   volume->SetProperty(property);
@@ -112,7 +143,7 @@ int main(int argc, char* argv[])
     t->Scale(1.5, 1.0, 1.0);
     volume->SetUserTransform(t);
   }
-  else if (testCase != "ct-bone")
+  else if (testCase != "ct-bone" && !labels)
   {
     std::cerr << "unknown case " << testCase << "\n";
     return 2;
@@ -127,11 +158,27 @@ int main(int argc, char* argv[])
   window->AddRenderer(renderer);
   window->SetSize(256, 256);
   renderer->ResetCamera();
-  renderer->GetActiveCamera()->Elevation(-80);  // the face (the data's -z side) toward the camera
+  if (labels)
+  {
+    // From the front, head up (VTK's NIfTI reader keeps the voxel axes:
+    // anterior toward +y, superior toward +z).
+    renderer->GetActiveCamera()->Elevation(90);
+    renderer->GetActiveCamera()->SetViewUp(0, 0, 1);
+  }
+  else
+  {
+    renderer->GetActiveCamera()->Elevation(-80);  // the face (the data's -z side) toward the camera
+  }
   renderer->GetActiveCamera()->OrthogonalizeViewUp();
   renderer->ResetCamera();
   const double background[3] = { 0.1, 0.1, 0.15 };
 
+  if (labels)
+  {
+    window->Render();  // vtkFixedPointVolumeRayCastMapper has no label maps: baseline only
+  }
+  else
+  {
   // VTK's software ray caster on the same volume, property and camera.
   vtkNew<vtkFixedPointVolumeRayCastMapper> reference;
   reference->SetInputConnection(reader->GetOutputPort());
@@ -155,6 +202,7 @@ int main(int argc, char* argv[])
   {
     std::cerr << "the volume does not cover the pixels VTK's own mapper covers\n";
     return 1;
+  }
   }
 
   if (mapper->GetAccumulatedSamples() != 32)

@@ -54,55 +54,61 @@ bool UsesGradientOpacity(vtkVolumeProperty* property, int component) {
          !IsConstantOne(property->GetStoredGradientOpacity(component));
 }
 
-void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, std::array<float, 2> scalarRange,
-                              int gradientProxy, std::array<float, 2> gradientRange, Scene& scene) {
-  scene.tfs.clear();
-  scene.materials.clear();
-  scene.selectors.clear();
+namespace {
+
+// The functions of one material: the property's component functions, or a
+// label's (null members fall back to the component's).
+struct MaterialFunctions {
+  vtkPiecewiseFunction* opacity = nullptr;
+  vtkColorTransferFunction* color = nullptr;  // null with grey: `grey` instead
+  vtkPiecewiseFunction* grey = nullptr;
+  vtkPiecewiseFunction* gradientOpacity = nullptr;  // null: not used
+};
+
+MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, vtkVolumeProperty* property,
+                          int component, const ProxyLayout& proxies, Scene& scene) {
   MaterialDesc m;
-  m.name = "volume";
-  const std::vector<float> x = Positions(scalarRange);
+  m.name = name;
+  const std::vector<float> x = Positions(proxies.scalarRange);
   const int n = (int)x.size();
 
   // Extinction from opacity per unit distance.
   std::vector<float> alpha(n), density(n);
-  vtkPiecewiseFunction* opacity = property->GetScalarOpacity(component);
   if (n > 1)
-    opacity->GetTable(x.front(), x.back(), n, alpha.data());
+    f.opacity->GetTable(x.front(), x.back(), n, alpha.data());
   else
-    alpha[0] = (float)opacity->GetValue(x[0]);
+    alpha[0] = (float)f.opacity->GetValue(x[0]);
   const double unit = std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
   for (int i = 0; i < n; ++i)
     density[i] = (float)(-std::log(1.0 - std::clamp((double)alpha[i], 0.0, 0.9999)) / unit);
   m.base[QuantityOffset(Quantity::Density)] = 1.f;
-  m.bindings.push_back({AddCurve(scene, "scalar opacity", 0, x, density, 1), Quantity::Density});
+  m.bindings.push_back({AddCurve(scene, name + " scalar opacity", 0, x, density, 1), Quantity::Density});
 
   // Gradient opacity multiplies the extinction.
-  if (gradientProxy >= 0) {
-    const std::vector<float> g = Positions(gradientRange);
+  if (f.gradientOpacity && proxies.gradient >= 0) {
+    const std::vector<float> g = Positions(proxies.gradientRange);
     std::vector<float> gv(g.size());
-    vtkPiecewiseFunction* f = property->GetGradientOpacity(component);
-    for (size_t i = 0; i < g.size(); ++i) gv[i] = (float)std::clamp(f->GetValue(g[i]), 0.0, 1.0);
-    m.bindings.push_back({AddCurve(scene, "gradient opacity", gradientProxy, g, gv, 1), Quantity::Density});
+    for (size_t i = 0; i < g.size(); ++i) gv[i] = (float)std::clamp(f.gradientOpacity->GetValue(g[i]), 0.0, 1.0);
+    m.bindings.push_back(
+        {AddCurve(scene, name + " gradient opacity", proxies.gradient, g, gv, 1), Quantity::Density});
   }
+  // A binary mask: empty where it is 0.
+  if (proxies.binaryMask >= 0)
+    m.bindings.push_back({AddCurve(scene, "binary mask", proxies.binaryMask, {0.f, 1.f}, {0.f, 1.f}, 1),
+                          Quantity::Density});
 
-  // Albedo from colour (grey when the property holds a grey function).
+  // Albedo from colour.
   std::vector<float> rgb(3 * n);
-  if (property->GetColorChannels(component) == 3) {
-    vtkColorTransferFunction* color = property->GetRGBTransferFunction(component);
-    if (n > 1) {
-      color->GetTable(x.front(), x.back(), n, rgb.data());
+  for (int i = 0; i < n; ++i) {
+    double c[3];
+    if (f.color) {
+      f.color->GetColor(x[i], c);
     } else {
-      double c[3];
-      color->GetColor(x[0], c);
-      for (int k = 0; k < 3; ++k) rgb[k] = (float)c[k];
+      c[0] = c[1] = c[2] = f.grey->GetValue(x[i]);
     }
-  } else {
-    vtkPiecewiseFunction* grey = property->GetGrayTransferFunction(component);
-    for (int i = 0; i < n; ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = (float)grey->GetValue(x[i]);
+    for (int k = 0; k < 3; ++k) rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
   }
-  for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
-  m.bindings.push_back({AddCurve(scene, "color", 0, x, rgb, 3), Quantity::Albedo});
+  m.bindings.push_back({AddCurve(scene, name + " color", 0, x, rgb, 3), Quantity::Albedo});
 
   // Shading.
   const bool shade = property->GetShade(component) != 0;
@@ -112,8 +118,53 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, std::a
       specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
   m.base[QuantityOffset(Quantity::Metallic)] = 0.f;
   m.base[QuantityOffset(Quantity::Anisotropy)] = 0.f;
-  scene.materials.push_back(std::move(m));
+  return m;
+}
+
+}  // namespace
+
+bool NeedsGradientProxy(vtkVolumeProperty* property, int component, bool labels) {
+  if (UsesGradientOpacity(property, component)) return true;
+  if (labels)
+    for (int label : property->GetLabelMapLabels())
+      if (!IsConstantOne(property->GetLabelGradientOpacity(label))) return true;
+  return false;
+}
+
+void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+  scene.tfs.clear();
+  scene.materials.clear();
+  scene.selectors.clear();
+  MaterialFunctions main;
+  main.opacity = property->GetScalarOpacity(component);
+  if (property->GetColorChannels(component) == 3)
+    main.color = property->GetRGBTransferFunction(component);
+  else
+    main.grey = property->GetGrayTransferFunction(component);
+  if (UsesGradientOpacity(property, component)) main.gradientOpacity = property->GetGradientOpacity(component);
+  scene.materials.push_back(MakeMaterial("volume", main, property, component, proxies, scene));
   scene.defaultMaterial = 0;
+
+  // Labels: a material each, picked by an MDPTF over the label map.
+  if (proxies.labels < 0) return;
+  TransferFunctionDesc selector;
+  selector.where = "label map";
+  selector.type = TFType::MDPTF;
+  selector.proxy = proxies.labels;
+  selector.channels = 1;
+  for (int label : property->GetLabelMapLabels()) {
+    if (label == 0) continue;  // 0 is unlabelled: the component's functions
+    MaterialFunctions f = main;
+    if (vtkPiecewiseFunction* o = property->GetLabelScalarOpacity(label)) f.opacity = o;
+    if (vtkColorTransferFunction* c = property->GetLabelColor(label)) f.color = c, f.grey = nullptr;
+    if (vtkPiecewiseFunction* g = property->GetLabelGradientOpacity(label)) f.gradientOpacity = IsConstantOne(g) ? nullptr : g;
+    selector.keys.push_back((float)label);
+    selector.materials.push_back((int)scene.materials.size());
+    scene.materials.push_back(MakeMaterial("label " + std::to_string(label), f, property, component, proxies, scene));
+  }
+  if (selector.keys.empty()) return;
+  scene.tfs.push_back(std::move(selector));
+  scene.selectors.push_back((int)scene.tfs.size() - 1);
 }
 
 void SetCameraFromVtk(vtkCamera* camera, Scene& scene) {

@@ -38,13 +38,24 @@ constexpr float kShadedSurfaceProbability = 0.8f;
 // Whether component `component`'s gradient opacity is in use (enabled and
 // not constant 1), so that the gradient-magnitude proxy is needed.
 bool UsesGradientOpacity(vtkVolumeProperty* property, int component);
+// Whether the component or, with labels, any label uses gradient opacity.
+bool NeedsGradientProxy(vtkVolumeProperty* property, int component, bool labels);
+
+// Which proxies the translation may read (index in Scene::proxies, or -1).
+struct ProxyLayout {
+  std::array<float, 2> scalarRange{0.f, 0.f};
+  int gradient = -1;  // gradient magnitude of the scalars
+  std::array<float, 2> gradientRange{0.f, 0.f};
+  int labels = -1;       // a label map (the mapper's mask, LABELMAP)
+  int binaryMask = -1;   // a binary mask (BINARY)
+};
 
 // Replaces the scene's TFs, materials and selectors with those of the
-// property's component `component`. `scalarRange` is the data's value range;
-// `gradientProxy` is the index of the gradient-magnitude proxy (or -1) and
-// `gradientRange` its value range.
-void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, std::array<float, 2> scalarRange,
-                              int gradientProxy, std::array<float, 2> gradientRange, Scene& scene);
+// property's component `component`: one material from its functions (the
+// default material), and with a label map one material per label that has
+// functions of its own, chosen by an MDPTF over the labels (a label's
+// material wins where its opacity is above zero, DESIGN.md's priority rule).
+void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
 
 // Sets the scene's camera from VTK's.
 void SetCameraFromVtk(vtkCamera* camera, Scene& scene);

@@ -18,11 +18,13 @@
 #include <vtkRayCastImageDisplayHelper.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
 
 #include "derived_proxies.h"
 #include "film.h"
+#include "label_alignment.h"
 #include "mmrtmImageDataConversion.h"
 #include "mmrtmVtkSceneTranslation.h"
 #include "render_backend.h"
@@ -43,10 +45,12 @@ struct vtkMultiMaterialVolumeMapper::Internals
 
   // Index-to-world of each proxy before the volume's matrix.
   std::vector<mmrtm::Affine3> ImageIndexToWorld;
-  std::array<float, 2> ScalarRange{ 0.f, 0.f }, GradientRange{ 0.f, 0.f };
-  int GradientProxy = -1;
+  mmrtm::ProxyLayout Layout;
+  vtkSmartPointer<vtkImageData> Mask;
+  int MaskTypeBuilt = -1;
 
   vtkDataObject* Data = nullptr;
+  vtkMTimeType MaskTime = 0;
   vtkMTimeType DataTime = 0, PropertyTime = 0, MapperTime = 0;
   std::vector<double> View;
   bool HasScene = false, Warned = false;
@@ -56,11 +60,20 @@ struct vtkMultiMaterialVolumeMapper::Internals
 
 namespace
 {
-// The latest modification among the property and its component-0 functions
-// (editing a function does not touch the property's own MTime).
+// The latest modification among the property and its component-0 and label
+// functions (editing a function does not touch the property's own MTime).
 vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
 {
   vtkMTimeType t = p->GetMTime();
+  for (int label : p->GetLabelMapLabels())
+  {
+    if (vtkPiecewiseFunction* f = p->GetLabelScalarOpacity(label))
+      t = std::max(t, f->GetMTime());
+    if (vtkPiecewiseFunction* f = p->GetLabelGradientOpacity(label))
+      t = std::max(t, f->GetMTime());
+    if (vtkColorTransferFunction* f = p->GetLabelColor(label))
+      t = std::max(t, f->GetMTime());
+  }
   t = std::max(t, p->GetScalarOpacity(0)->GetMTime());
   t = std::max(t, p->GetGradientOpacity(0)->GetMTime());
   if (p->GetColorChannels(0) == 3)
@@ -140,6 +153,20 @@ void vtkMultiMaterialVolumeMapper::ResetAccumulation()
     this->Internal->Film->Reset();
 }
 
+void vtkMultiMaterialVolumeMapper::SetMaskInput(vtkImageData* mask)
+{
+  if (this->Internal->Mask != mask)
+  {
+    this->Internal->Mask = mask;
+    this->Modified();
+  }
+}
+
+vtkImageData* vtkMultiMaterialVolumeMapper::GetMaskInput()
+{
+  return this->Internal->Mask;
+}
+
 int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
 {
   return this->Internal->Film ? static_cast<int>(this->Internal->Film->Samples()) : 0;
@@ -195,30 +222,49 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     if (!input)
       throw mmrtm::InputError("the input is not a vtkImageData");
     bool restart = false;
-    if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene)
+    vtkImageData* mask = in.Mask;
+    const vtkMTimeType maskTime = mask ? mask->GetMTime() : 0;
+    const bool labels = mask && this->MaskType == LABELMAP;
+    const bool needGradient = mmrtm::NeedsGradientProxy(property, 0, labels);
+    if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
+      this->MaskType != in.MaskTypeBuilt || needGradient != (in.Layout.gradient >= 0))
     {
-      in.Scene.proxies.clear();
+      mmrtm::Scene& scene = in.Scene;
+      scene.proxies.clear();
       in.ImageIndexToWorld.clear();
       int cellFlag = 0;
       vtkDataArray* scalars = vtkAbstractMapper::GetScalars(input, this->ScalarMode, this->ArrayAccessMode,
         this->ArrayId, this->ArrayName, cellFlag);
       if (cellFlag)
         throw mmrtm::InputError("cell scalars are not supported; give point scalars");
-      in.Scene.proxies.push_back(mmrtm::ImageDataToHostVolume(
+      scene.proxies.push_back(mmrtm::ImageDataToHostVolume(
         input, scalars, 0, "scalars", mmrtm::Interpolation::Trilinear));
-      in.ScalarRange = in.Scene.proxies[0].ValueRange();
-      in.GradientProxy = -1;
-      if (mmrtm::UsesGradientOpacity(property, 0))
+      in.Layout = mmrtm::ProxyLayout();
+      in.Layout.scalarRange = scene.proxies[0].ValueRange();
+      if (needGradient)
       {
-        in.Scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(in.Scene.proxies[0], "gradient"));
-        in.GradientProxy = 1;
-        in.GradientRange = in.Scene.proxies[1].ValueRange();
+        in.Layout.gradient = static_cast<int>(scene.proxies.size());
+        scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[0], "gradient"));
+        in.Layout.gradientRange = scene.proxies.back().ValueRange();
       }
-      for (const mmrtm::HostVolume& v : in.Scene.proxies)
+      if (mask)
+      {
+        // Labels are never interpolated; a mask on another grid is put on
+        // the input's by nearest neighbour in world space.
+        mmrtm::HostVolume m = mmrtm::ImageDataToHostVolume(
+          mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
+        m = mmrtm::AlignLabelsToVolume(std::move(m), scene.proxies[0]);
+        (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
+        scene.proxies.push_back(std::move(m));
+      }
+      for (const mmrtm::HostVolume& v : scene.proxies)
         in.ImageIndexToWorld.push_back(v.indexToWorld);
-      in.Scene.MarkDataModified();
+      scene.gradientProxy = 0;
+      scene.MarkDataModified();
       in.Data = input;
       in.DataTime = input->GetMTime();
+      in.MaskTime = maskTime;
+      in.MaskTypeBuilt = this->MaskType;
       in.PropertyTime = 0;  // translate the property again
       ++in.SceneBuilds;
       restart = true;
@@ -228,14 +274,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     const vtkMTimeType propertyTime = PropertyMTime(property);
     if (propertyTime != in.PropertyTime)
     {
-      if (mmrtm::UsesGradientOpacity(property, 0) != (in.GradientProxy >= 0))
-      {
-        in.HasScene = false;  // the gradient proxy comes or goes: a data rebuild
-        this->Render(ren, vol);
-        return;
-      }
-      mmrtm::SetMaterialsFromProperty(
-        property, 0, in.ScalarRange, in.GradientProxy, in.GradientRange, in.Scene);
+      mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene);
       in.PropertyTime = propertyTime;
       ++in.Refits;
       restart = true;

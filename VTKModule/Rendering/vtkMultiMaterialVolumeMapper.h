@@ -26,8 +26,7 @@
  * at the depth of the volume's nearest bounding-box corner.
  *
  * Not supported yet (a warning is given once): blend modes other than
- * composite, cropping, clipping planes, label maps (mask input), more than
- * one component.
+ * composite, cropping, clipping planes, more than one component.
  *
  * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
  */
@@ -39,7 +38,7 @@
 
 #include <memory>  // for std::unique_ptr
 
-class vtkRayCastImageDisplayHelper;
+class vtkImageData;
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper
 {
@@ -116,6 +115,29 @@ public:
   vtkGetMacro(ShadowExtinctionScale, double);
   ///@}
 
+  ///@{
+  /**
+   * A mask on the input's grid (or, resampled by nearest neighbour, on any
+   * grid that overlaps it in world space), as in vtkGPUVolumeRayCastMapper.
+   * LABELMAP (the default): every label with a colour, scalar-opacity or
+   * gradient-opacity function in the volume property (SetLabelColor, ...)
+   * becomes a material of its own, chosen where the mask has that label and
+   * its opacity is above zero; elsewhere the property's component-0
+   * functions apply. BINARY: voxels where the mask is 0 are empty.
+   */
+  void SetMaskInput(vtkImageData* mask);
+  vtkImageData* GetMaskInput();
+  enum MaskTypes
+  {
+    BINARY = 0,
+    LABELMAP = 1
+  };
+  vtkSetClampMacro(MaskType, int, BINARY, LABELMAP);
+  vtkGetMacro(MaskType, int);
+  void SetMaskTypeToBinary() { this->SetMaskType(BINARY); }
+  void SetMaskTypeToLabelMap() { this->SetMaskType(LABELMAP); }
+  ///@}
+
   /**
    * Discards the accumulated samples; the next Render() starts again.
    */
@@ -155,6 +177,7 @@ protected:
   int Backend = AUTO;
   double Exposure = 1.0;
   double ShadowExtinctionScale = 0.8;
+  int MaskType = LABELMAP;
 
 private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
