@@ -13,7 +13,7 @@ import tempfile
 import unittest
 
 from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
-from vtkmodules.vtkImagingCore import vtkImageShiftScale
+from vtkmodules.vtkImagingCore import vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
 from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
                                          vtkVolumeProperty, vtkWindowToImageFilter)
@@ -149,6 +149,37 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.counts(), (2, 2, 2))
         s.render()
         self.assertEqual(s.counts(), (2, 2, 2))
+
+    def test_label_function_edit_refits(self):
+        # A label map (label 1 where the CT is above 1500), coloured blue.
+        s = Scene()
+        threshold = vtkImageThreshold()
+        threshold.SetInputConnection(s.reader.GetOutputPort())
+        threshold.ThresholdByUpper(1500)
+        threshold.SetInValue(1)
+        threshold.SetOutValue(0)
+        threshold.SetOutputScalarTypeToUnsignedChar()
+        threshold.Update()
+        s.mapper.SetMaskInput(threshold.GetOutput())
+        s.mapper.SetMaskTypeToLabelMap()
+        blue = vtkColorTransferFunction()
+        blue.AddRGBPoint(0, 0.1, 0.2, 0.9)
+        s.property.SetLabelColor(1, blue)
+        s.render()
+        s.render()
+        self.assertEqual(s.counts(), (1, 1, 1))
+        before = s.pixels()
+        # VTK's gotcha: editing the label's function leaves the property's
+        # MTime alone. The mapper watches the function itself.
+        blue.AddRGBPoint(0, 0.9, 0.8, 0.1)
+        s.render()
+        self.assertEqual(s.counts(), (1, 2, 2))
+        self.assertGreater(mean_abs_difference(before, s.pixels()), 0.005)
+        # A new mask is a data change.
+        threshold.SetInValue(2)
+        threshold.Update()
+        s.render()
+        self.assertEqual(s.counts(), (2, 3, 3))
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()
