@@ -72,17 +72,21 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
   const std::vector<float> x = Positions(proxies.scalarRange);
   const int n = (int)x.size();
 
-  // Extinction from opacity per unit distance.
-  std::vector<float> alpha(n), density(n);
-  if (n > 1)
-    f.opacity->GetTable(x.front(), x.back(), n, alpha.data());
+  // Extinction from opacity per unit distance, over the opacity component
+  // (dependent components) or the scalars.
+  const int opacityProxy = proxies.opacity >= 0 ? proxies.opacity : 0;
+  const std::vector<float> xo = proxies.opacity >= 0 ? Positions(proxies.opacityRange) : x;
+  const int no = (int)xo.size();
+  std::vector<float> alpha(no), density(no);
+  if (no > 1)
+    f.opacity->GetTable(xo.front(), xo.back(), no, alpha.data());
   else
-    alpha[0] = (float)f.opacity->GetValue(x[0]);
+    alpha[0] = (float)f.opacity->GetValue(xo[0]);
   const double unit = std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < no; ++i)
     density[i] = (float)(-std::log(1.0 - std::clamp((double)alpha[i], 0.0, 0.9999)) / unit);
   m.base[QuantityOffset(Quantity::Density)] = 1.f;
-  m.bindings.push_back({AddCurve(scene, name + " scalar opacity", 0, x, density, 1), Quantity::Density});
+  m.bindings.push_back({AddCurve(scene, name + " scalar opacity", opacityProxy, xo, density, 1), Quantity::Density});
 
   // Gradient opacity multiplies the extinction.
   if (f.gradientOpacity && proxies.gradient >= 0) {
@@ -97,6 +101,17 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     m.bindings.push_back({AddCurve(scene, "binary mask", proxies.binaryMask, {0.f, 1.f}, {0.f, 1.f}, 1),
                           Quantity::Density});
 
+  // Albedo: the RGB components themselves (4 dependent components), one
+  // channel per proxy, multiplied.
+  if (proxies.rgb[0] >= 0) {
+    for (int c = 0; c < 3; ++c) {
+      std::vector<float> values = {1.f, 1.f, 1.f, 1.f, 1.f, 1.f};
+      values[c] = 0.f;
+      values[3 + c] = 1.f;
+      m.bindings.push_back({AddCurve(scene, name + " rgb", proxies.rgb[c], {0.f, proxies.colorScale}, values, 3),
+                            Quantity::Albedo});
+    }
+  } else {
   // Albedo from colour.
   std::vector<float> rgb(3 * n);
   for (int i = 0; i < n; ++i) {
@@ -109,6 +124,7 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     for (int k = 0; k < 3; ++k) rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
   }
   m.bindings.push_back({AddCurve(scene, name + " color", 0, x, rgb, 3), Quantity::Albedo});
+  }
 
   // Shading.
   const bool shade = property->GetShade(component) != 0;

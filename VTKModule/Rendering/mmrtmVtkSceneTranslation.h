@@ -5,6 +5,12 @@
 // - Scalar opacity alpha(x) per ScalarOpacityUnitDistance d becomes the
 //   extinction sigma_t(x) = -ln(1 - alpha(x)) / d, so that a slab of
 //   thickness d lets 1 - alpha through, as in VTK's compositing.
+// - Dependent components (IndependentComponents off), as VTK: 2 components
+//   are colour (through the colour function) and opacity (through the
+//   scalar-opacity function); 4 are RGB (the albedo itself, unsigned char
+//   scaled to 0-1) and opacity. The RGB albedo is the product of three
+//   3-channel CCTFs, one per component proxy, each scaling one channel: the
+//   merge rule "coefficients from several proxies multiply".
 // - Colour becomes the albedo; gradient opacity g(|grad x|) multiplies
 //   sigma_t through a gradient-magnitude proxy (made only when used).
 // - The functions are sampled at kTableSize points over the scalar range, as
@@ -48,6 +54,14 @@ struct ProxyLayout {
   std::array<float, 2> gradientRange{0.f, 0.f};
   int labels = -1;       // a label map (the mapper's mask, LABELMAP)
   int binaryMask = -1;   // a binary mask (BINARY)
+  // IndependentComponents off: with 2 components, proxy 0 is coloured by
+  // the colour function and `opacity` (component 1) gives the opacity; with
+  // 4, `rgb` are the colour components (divided by colorScale) and `opacity`
+  // (component 3) goes through the scalar-opacity function.
+  int opacity = -1;
+  std::array<float, 2> opacityRange{0.f, 0.f};
+  int rgb[3] = {-1, -1, -1};
+  float colorScale = 255.f;
 };
 
 // Replaces the scene's TFs, materials and selectors with those of the

@@ -48,6 +48,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   mmrtm::ProxyLayout Layout;
   vtkSmartPointer<vtkImageData> Mask;
   int MaskTypeBuilt = -1;
+  int DependentBuilt = -1;  // components used as colour + opacity (IndependentComponents off)
 
   vtkDataObject* Data = nullptr;
   vtkMTimeType MaskTime = 0;
@@ -225,26 +226,62 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     vtkImageData* mask = in.Mask;
     const vtkMTimeType maskTime = mask ? mask->GetMTime() : 0;
     const bool labels = mask && this->MaskType == LABELMAP;
-    const bool needGradient = mmrtm::NeedsGradientProxy(property, 0, labels);
+    int cellFlag = 0;
+    vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
+      input, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+    if (!scalars || cellFlag)
+      throw mmrtm::InputError("the input needs point scalars");
+    const int components = scalars->GetNumberOfComponents();
+    const int dependent =
+      !property->GetIndependentComponents() && (components == 2 || components == 4) ? components : 0;
+    // 4 dependent components fill the 4 proxies: no room for a gradient.
+    const bool needGradient = dependent != 4 && mmrtm::NeedsGradientProxy(property, 0, labels);
     if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
-      this->MaskType != in.MaskTypeBuilt || needGradient != (in.Layout.gradient >= 0))
+      this->MaskType != in.MaskTypeBuilt || needGradient != (in.Layout.gradient >= 0) ||
+      dependent != in.DependentBuilt)
     {
+      if (!in.Warned && components > 1 && !dependent)
+      {
+        vtkWarningMacro("only component 0 of " << components << " independent components is rendered");
+        in.Warned = true;
+      }
       mmrtm::Scene& scene = in.Scene;
       scene.proxies.clear();
       in.ImageIndexToWorld.clear();
-      int cellFlag = 0;
-      vtkDataArray* scalars = vtkAbstractMapper::GetScalars(input, this->ScalarMode, this->ArrayAccessMode,
-        this->ArrayId, this->ArrayName, cellFlag);
-      if (cellFlag)
-        throw mmrtm::InputError("cell scalars are not supported; give point scalars");
-      scene.proxies.push_back(mmrtm::ImageDataToHostVolume(
-        input, scalars, 0, "scalars", mmrtm::Interpolation::Trilinear));
       in.Layout = mmrtm::ProxyLayout();
+      auto component = [&](int c, const char* name) {
+        scene.proxies.push_back(
+          mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
+        return static_cast<int>(scene.proxies.size()) - 1;
+      };
+      component(0, dependent == 4 ? "red" : "scalars");
       in.Layout.scalarRange = scene.proxies[0].ValueRange();
+      scene.gradientProxy = 0;
+      if (dependent == 2)
+      {
+        in.Layout.opacity = component(1, "opacity");
+      }
+      else if (dependent == 4)
+      {
+        in.Layout.rgb[0] = 0;
+        in.Layout.rgb[1] = component(1, "green");
+        in.Layout.rgb[2] = component(2, "blue");
+        in.Layout.opacity = component(3, "opacity");
+        float top = 0.f;
+        for (int c = 0; c < 3; ++c)
+          top = std::max(top, scene.proxies[c].ValueRange()[1]);
+        in.Layout.colorScale = scalars->GetDataType() == VTK_UNSIGNED_CHAR ? 255.f : std::max(top, 1e-6f);
+      }
+      if (in.Layout.opacity >= 0)
+      {
+        in.Layout.opacityRange = scene.proxies[in.Layout.opacity].ValueRange();
+        scene.gradientProxy = in.Layout.opacity;  // VTK shades dependent data by the opacity component
+      }
       if (needGradient)
       {
+        const int source = scene.gradientProxy;
         in.Layout.gradient = static_cast<int>(scene.proxies.size());
-        scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[0], "gradient"));
+        scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[source], "gradient"));
         in.Layout.gradientRange = scene.proxies.back().ValueRange();
       }
       if (mask)
@@ -257,14 +294,18 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
         scene.proxies.push_back(std::move(m));
       }
+      if (scene.proxies.size() > mmrtm::kMaxProxies)
+        throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
+          std::to_string(scene.proxies.size()) + " proxy volumes; at most " +
+          std::to_string(mmrtm::kMaxProxies) + " are supported");
       for (const mmrtm::HostVolume& v : scene.proxies)
         in.ImageIndexToWorld.push_back(v.indexToWorld);
-      scene.gradientProxy = 0;
       scene.MarkDataModified();
       in.Data = input;
       in.DataTime = input->GetMTime();
       in.MaskTime = maskTime;
       in.MaskTypeBuilt = this->MaskType;
+      in.DependentBuilt = dependent;
       in.PropertyTime = 0;  // translate the property again
       ++in.SceneBuilds;
       restart = true;
