@@ -15,7 +15,8 @@ import unittest
 from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
 from vtkmodules.vtkImagingCore import vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
-from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
+from vtkmodules.vtkFiltersSources import vtkSphereSource
+from vtkmodules.vtkRenderingCore import (vtkActor, vtkPolyDataMapper, vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
                                          vtkVolumeProperty, vtkWindowToImageFilter)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
@@ -180,6 +181,42 @@ class MapperTest(unittest.TestCase):
         threshold.Update()
         s.render()
         self.assertEqual(s.counts(), (2, 3, 3))
+
+    def test_opaque_geometry_hides_and_moving_it_restarts(self):
+        s = Scene()
+        s.render()
+        # A green sphere through the side of the head: partly outside the
+        # skull (visible), partly inside (hidden by the bone in front).
+        sphere = vtkSphereSource()
+        x, y, z = s.reader.GetOutput().GetCenter()
+        sphere.SetCenter(x + 80, y, z)
+        sphere.SetRadius(45)
+        mapper = vtkPolyDataMapper()
+        mapper.SetInputConnection(sphere.GetOutputPort())
+        actor = vtkActor()
+        actor.SetMapper(mapper)
+        actor.GetProperty().SetColor(0.0, 1.0, 0.0)
+        s.renderer.AddActor(actor)
+        s.render()
+        self.assertEqual(s.counts(), (1, 1, 2), "new geometry: a restart")
+
+        def green(pixels):
+            return sum(1 for i in range(0, len(pixels), 3) if pixels[i + 1] > pixels[i] + 40)
+
+        with_volume = green(s.pixels())
+        s.volume.VisibilityOff()
+        s.render()
+        alone = green(s.pixels())
+        s.volume.VisibilityOn()
+        s.render()
+        self.assertGreater(with_volume, 0.5 * alone, "the sphere in front of the bone shows")
+        self.assertLess(with_volume, alone - 20, "the bone in front hides part of the sphere")
+        count = s.counts()
+        s.render()
+        self.assertEqual(s.counts(), count, "unchanged geometry: no restart")
+        actor.SetPosition(5, 0, 0)
+        s.render()
+        self.assertEqual(s.counts()[2], count[2] + 1, "moved geometry: a restart")
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()

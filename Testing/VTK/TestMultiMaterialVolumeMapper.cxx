@@ -10,7 +10,10 @@
 // "labels" (a CT angiography whose vessel label map gives per-label colours
 // and opacities through SetMaskInput and the property's label functions) or
 // "rgba" (a 4-component unsigned char volume, IndependentComponents off: RGB
-// is the colour, the fourth component goes through the opacity function).
+// is the colour, the fourth component goes through the opacity function) or
+// "mesh" (the head CT with an opaque sphere through it: the sphere hides the
+// volume behind it, the bone in front hides the sphere, as camera rays stop
+// at the depth buffer of the opaque geometry).
 //
 // VTK 9.1's vtkRegressionTestImage tolerates a difference of up to 105 of
 // 255 in a channel (a whole background of another colour passes), so the
@@ -35,7 +38,11 @@
 #include <vtkSmartPointer.h>
 #include <vtkNew.h>
 #include <vtkFixedPointVolumeRayCastMapper.h>
+#include <vtkActor.h>
 #include <vtkNIFTIImageReader.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkSphereSource.h>
 #include <vtkNrrdReader.h>
 #include <vtkXMLImageDataReader.h>
 #include <vtkUnsignedCharArray.h>
@@ -194,7 +201,7 @@ int main(int argc, char* argv[])
     t->Scale(1.5, 1.0, 1.0);
     volume->SetUserTransform(t);
   }
-  else if (testCase != "ct-bone" && !labels && !rgba)
+  else if (testCase != "ct-bone" && !labels && !rgba && testCase != "mesh")
   {
     std::cerr << "unknown case " << testCase << "\n";
     return 2;
@@ -202,6 +209,24 @@ int main(int argc, char* argv[])
 
   vtkNew<vtkRenderer> renderer;
   renderer->AddVolume(volume);
+  vtkNew<vtkSphereSource> sphere;
+  vtkNew<vtkPolyDataMapper> sphereMapper;
+  vtkNew<vtkActor> sphereActor;
+  if (testCase == "mesh")
+  {
+    // Through the middle of the head, reaching out of the skull.
+    reader->Update();
+    double center[3];
+    vtkImageData::SafeDownCast(reader->GetOutputDataObject(0))->GetCenter(center);
+    sphere->SetCenter(center[0] + 40, center[1], center[2] - 30);
+    sphere->SetRadius(45);
+    sphere->SetThetaResolution(48);
+    sphere->SetPhiResolution(48);
+    sphereMapper->SetInputConnection(sphere->GetOutputPort());
+    sphereActor->SetMapper(sphereMapper);
+    sphereActor->GetProperty()->SetColor(0.2, 0.8, 0.3);
+    renderer->AddActor(sphereActor);
+  }
   renderer->SetBackground(0.15, 0.25, 0.55);
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
@@ -224,9 +249,9 @@ int main(int argc, char* argv[])
   renderer->ResetCamera();
   const double background[3] = { 0.15, 0.25, 0.55 };  // unlike any grey, so dark shading still counts
 
-  if (labels)
+  if (labels || testCase == "mesh")
   {
-    window->Render();  // vtkFixedPointVolumeRayCastMapper has no label maps: baseline only
+    window->Render();  // label maps; geometry: baseline only
   }
   else
   {

@@ -54,6 +54,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   vtkMTimeType MaskTime = 0;
   vtkMTimeType DataTime = 0, PropertyTime = 0, MapperTime = 0;
   std::vector<double> View;
+  std::vector<float> Depth;  // the depth buffer under the volume at the last restart
   bool HasScene = false, Warned = false;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0;
@@ -129,6 +130,55 @@ bool SameView(const std::vector<double>& a, const std::vector<double>& b)
     if (std::abs(a[i] - b[i]) > 1e-6 * std::max({ 1.0, std::abs(a[i]), std::abs(b[i]) }))
       return false;
   return true;
+}
+
+// The depth buffer of the viewport (opaque geometry drawn before volumes),
+// window depth in [0, 1], rows bottom first; empty without any geometry.
+std::vector<float> ReadDepth(vtkRenderer* ren, int width, int height, int x0, int y0)
+{
+  std::vector<float> depth(static_cast<size_t>(width) * height, 1.f);
+  ren->GetRenderWindow()->GetZbufferData(x0, y0, x0 + width - 1, y0 + height - 1, depth.data());
+  for (float z : depth)
+    if (z < 1.f)
+      return depth;
+  return {};
+}
+
+// Per pixel (rows top first, as the film): the distance along the camera
+// ray to the geometry in the depth buffer, kInfinity where there is none.
+// Perspective rays start at the camera, orthographic ones in the plane
+// through it.
+std::vector<float> CameraRayMaxDistance(vtkRenderer* ren, const std::vector<float>& depth, int width, int height)
+{
+  vtkCamera* camera = ren->GetActiveCamera();
+  vtkNew<vtkMatrix4x4> inverse;
+  inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(ren->GetTiledAspectRatio(), -1, 1));
+  inverse->Invert();
+  const double* eye = camera->GetPosition();
+  double dir[3];
+  camera->GetDirectionOfProjection(dir);
+  const bool parallel = camera->GetParallelProjection() != 0;
+  std::vector<float> t(depth.size(), mmrtm::kInfinity);
+  for (int row = 0; row < height; ++row)
+    for (int x = 0; x < width; ++x)
+    {
+      const float z = depth[static_cast<size_t>(row) * width + x];
+      if (z >= 1.f)
+        continue;
+      const double ndc[4] = { 2.0 * (x + 0.5) / width - 1.0, 2.0 * (row + 0.5) / height - 1.0, 2.0 * z - 1.0, 1.0 };
+      double p[4];
+      inverse->MultiplyPoint(ndc, p);
+      double d[3], len2 = 0, along = 0;
+      for (int k = 0; k < 3; ++k)
+      {
+        d[k] = p[k] / p[3] - eye[k];
+        len2 += d[k] * d[k];
+        along += d[k] * dir[k];
+      }
+      t[static_cast<size_t>(height - 1 - row) * width + x] =
+        static_cast<float>(parallel ? along : std::sqrt(len2));
+    }
+  return t;
 }
 
 mmrtm::Affine3 ToAffine(vtkMatrix4x4* m)
@@ -321,11 +371,14 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       restart = true;
     }
 
-    // View: camera, lights, matrix, viewport (by value), and the mapper's own settings.
+    // View: camera, lights, matrix, viewport (by value), the opaque
+    // geometry (its depth), and the mapper's own settings.
     std::vector<double> view = ViewSignature(ren, vol, width, height);
-    if (!SameView(view, in.View) || this->GetMTime() != in.MapperTime || !in.Film)
+    std::vector<float> depth = ReadDepth(ren, width, height, originX, originY);
+    if (!SameView(view, in.View) || depth != in.Depth || this->GetMTime() != in.MapperTime || !in.Film)
     {
       in.View = std::move(view);
+      in.Depth = std::move(depth);
       in.MapperTime = this->GetMTime();
       restart = true;
     }
@@ -337,6 +390,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
         in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
       mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
+      // Camera rays stop at opaque geometry: it hides the volume behind it,
+      // and the volume in front of it hides it.
+      in.Scene.cameraRayMaxDistance =
+        in.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, in.Depth, width, height);
       mmrtm::SetLightsFromVtk(ren, property, in.Scene);
       mmrtm::RenderSettings& rs = in.Scene.render;
       rs.width = width;
@@ -383,17 +440,9 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   for (int y = 0; y < height / 2; ++y)
     std::swap_ranges(rgba.begin() + y * row, rgba.begin() + (y + 1) * row, rgba.begin() + (height - 1 - y) * row);
 
-  // Drawn at the depth of the volume's nearest bounding-box corner.
-  double bounds[6];
-  vol->GetBounds(bounds);
-  double depth = 1.0;
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    ren->SetWorldPoint(bounds[corner & 1], bounds[2 + ((corner >> 1) & 1)], bounds[4 + ((corner >> 2) & 1)], 1.0);
-    ren->WorldToDisplay();
-    depth = std::min(depth, ren->GetDisplayPoint()[2]);
-  }
-  depth = std::clamp(depth, 1e-6, 1.0);
+  // Drawn in front of everything: the camera rays already stopped at the
+  // opaque geometry, so where it is in front the image is transparent.
+  const double depth = 1e-6;
 
   vtkNew<vtkRayCastImageDisplayHelper> helper;  // the OpenGL one, through the object factory
   helper->PreMultipliedColorsOn();

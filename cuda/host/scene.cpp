@@ -263,6 +263,13 @@ SceneView Scene::Build() {
   modifiedRegions_.clear();
 
   s.camera = BuildCamera();
+  if (!cameraRayMaxDistance.empty()) {
+    if (cameraRayMaxDistance.size() != (size_t)render.width * render.height)
+      throw InputError("scene: cameraRayMaxDistance holds " + std::to_string(cameraRayMaxDistance.size()) +
+                       " values for a " + std::to_string(render.width) + " x " + std::to_string(render.height) +
+                       " image");
+    s.cameraRayMaxDistance = cameraRayMaxDistance.data();
+  }
   lightViews_ = lights;
   for (const CameraLight& cl : cameraLights) {
     const float az = cl.azimuth * kPi / 180.f, el = cl.elevation * kPi / 180.f;

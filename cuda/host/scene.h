@@ -95,6 +95,10 @@ class Scene {
   std::shared_ptr<EnvironmentMap> environment;  // optional; null: no environment light
   CameraDesc camera;
   RenderSettings render;
+  // Optional: render.width * render.height distances, row 0 at the top, at
+  // which camera rays stop (opaque geometry drawn by the host application,
+  // from its depth buffer; kInfinity where there is none). Empty: no limit.
+  std::vector<float> cameraRayMaxDistance;
 
   int ProxyIndex(const std::string& name) const;  // -1 if absent
   int MaterialIndex(const std::string& name) const;

@@ -57,6 +57,8 @@ void ForEachArray(SceneView& s, Visit visit) {
 
   s.majorants.grid.majorants = visit(s.majorants.grid.majorants, MajorantCount(s.majorants), SceneArrayKind::Majorants);
   s.lights = visit(s.lights, (size_t)s.lightCount, SceneArrayKind::Tables);
+  s.cameraRayMaxDistance =
+      visit(s.cameraRayMaxDistance, (size_t)s.camera.width * s.camera.height, SceneArrayKind::Tables);
 
   EnvironmentView& e = s.environment;
   e.texels = visit(e.texels, (size_t)e.width * e.height, SceneArrayKind::Environment);

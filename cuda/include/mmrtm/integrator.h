@@ -27,14 +27,19 @@ struct PixelSample {
   float alpha = 0.f;  // 1 when the camera ray collided with the volume
 };
 
-MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, TraceCounters& ctr) {
+// `cameraTMax`: how far the camera ray may go (opaque geometry of the host
+// application in front, e.g. a VTK mesh); beyond it the pixel is not the
+// volume's and nothing (not even the environment) is seen.
+MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, TraceCounters& ctr,
+                                    float cameraTMax = kInfinity) {
   PixelSample out;
   RGB beta(1.f);
   float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
   float lightSelectPdf = s.lightCount > 0 ? 1.f / (float)s.lightCount : 0.f;
   for (int depth = 0;; ++depth) {
-    FreePathResult fp = SampleFreePath(s, ray, kInfinity, rng, ctr);
+    FreePathResult fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr);
     if (!fp.collided) {
+      if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
         RGB Le = s.environment.Le(ray.d);
         if (depth == 0) {
@@ -116,7 +121,8 @@ MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, in
   float fx = rng.Uniform(), fy = rng.Uniform(), l0 = rng.Uniform(), l1 = rng.Uniform();
   Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
   ++ctr.paths;
-  return Li(s, ray, rng, ctr);
+  const float tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
+  return Li(s, ray, rng, ctr, tMax);
 }
 
 }  // namespace mmrtm

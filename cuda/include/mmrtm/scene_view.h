@@ -38,6 +38,10 @@ struct SceneView {
   int environmentLight = -1;  // index of the environment in lights, or -1
   EnvironmentView environment;
   CameraView camera;
+  // Optional, camera.width * camera.height floats, row 0 at the top: how
+  // far each pixel's camera ray may go before opaque geometry that the host
+  // application drew (kInfinity where there is none). Null: no limit.
+  const float* cameraRayMaxDistance = nullptr;
   IntegratorSettings settings;
 
   // The ray in proxy 0's index space, and its parametric interval inside the
