@@ -67,3 +67,41 @@ TEST(Determinism, AnotherSeedGivesAnotherImage) {
 
 }  // namespace
 }  // namespace mmrtm
+
+namespace mmrtm {
+namespace {
+
+// Camera rays stop at cameraRayMaxDistance (opaque geometry of the host
+// application): a limit at the camera leaves the image empty and
+// transparent, a limit beyond the volume changes nothing, and a limit in
+// the middle of the volume lowers the coverage.
+TEST(CameraRayLimit, StopsCameraRaysOnly) {
+  Scene scene = MakeScene();
+  scene.render.width = 37;
+  scene.render.height = 23;
+  // A finite limit means geometry stands there and hides the background; with
+  // the background hidden anyway (as in the VTK mapper), a far limit is no limit.
+  scene.render.integrator.backgroundVisible = false;
+  const std::vector<float> free = Render(scene, 2, 5, 1);
+  scene.cameraRayMaxDistance.assign(37 * 23, 1e6f);
+  EXPECT_EQ(Render(scene, 2, 5, 1), free) << "a limit beyond the volume changes nothing";
+  scene.cameraRayMaxDistance.assign(37 * 23, 1e-4f);
+  for (float v : Render(scene, 2, 5, 1)) EXPECT_EQ(v, 0.f) << "geometry at the camera hides everything";
+  double coverageFree = 0, coverageHalf = 0;
+  for (size_t i = 3; i < free.size(); i += 4) coverageFree += free[i];
+  ASSERT_GT(coverageFree, 0.0);
+  scene.camera.autoFrame = true;
+  const SceneView view = scene.Build();
+  // Half way: the distance from the camera to the volume's centre.
+  const float half = Length(scene.proxies[0].WorldCenter() - view.camera.position);
+  scene.cameraRayMaxDistance.assign(37 * 23, half);
+  const std::vector<float> halfImage = Render(scene, 2, 5, 1);
+  for (size_t i = 3; i < halfImage.size(); i += 4) coverageHalf += halfImage[i];
+  EXPECT_GT(coverageHalf, 0.0);
+  EXPECT_LT(coverageHalf, coverageFree - 1.0) << "geometry in the middle hides what lies behind it";
+  scene.cameraRayMaxDistance.assign(5, 1.f);
+  EXPECT_THROW(scene.Build(), InputError) << "a limit of the wrong size";
+}
+
+}  // namespace
+}  // namespace mmrtm
