@@ -218,6 +218,25 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(s.counts()[2], count[2] + 1, "moved geometry: a restart")
 
+    def test_interaction_renders_a_preview_then_refines(self):
+        s = Scene()
+        s.render()
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 4)
+        # vtkRenderWindowInteractor asks for 15 frames per second while the camera moves.
+        s.window.SetDesiredUpdateRate(15.0)
+        s.renderer.GetActiveCamera().Azimuth(10)
+        s.render()
+        self.assertEqual(s.mapper.GetNumberOfInteractiveRenders(), 1)
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 0, "a preview does not accumulate")
+        self.assertGreater(coverage(s.pixels()), 0.05, "the preview shows the volume")  # renders a preview again
+        previews = s.mapper.GetNumberOfInteractiveRenders()
+        # When the camera stops, the full-resolution accumulation starts again.
+        s.window.SetDesiredUpdateRate(0.0001)
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+        self.assertEqual(s.mapper.GetNumberOfInteractiveRenders(), previews)
+
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()
         a.render()

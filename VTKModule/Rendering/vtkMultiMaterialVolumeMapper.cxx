@@ -1,6 +1,7 @@
 #include "vtkMultiMaterialVolumeMapper.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <string>
@@ -57,7 +58,11 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::vector<float> Depth;  // the depth buffer under the volume at the last restart
   bool HasScene = false, Warned = false;
 
-  int SceneBuilds = 0, Refits = 0, Restarts = 0;
+  int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0;
+  // While the interactor moves the camera: a preview at 1/PreviewFactor of
+  // the resolution, 1 sample per pixel, the factor adapted to the frame rate.
+  std::unique_ptr<mmrtm::Film> Preview;
+  int PreviewFactor = 4;
 };
 
 namespace
@@ -231,6 +236,11 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfSceneBuilds()
 int vtkMultiMaterialVolumeMapper::GetNumberOfRefits()
 {
   return this->Internal->Refits;
+}
+
+int vtkMultiMaterialVolumeMapper::GetNumberOfInteractiveRenders()
+{
+  return this->Internal->InteractiveRenders;
 }
 
 int vtkMultiMaterialVolumeMapper::GetNumberOfRestarts()
@@ -407,8 +417,6 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.HasScene = true;
       ++in.Restarts;
     }
-    const mmrtm::SceneView sceneView = in.Scene.Build();
-
     if (!in.Renderer || in.RendererBackend != this->Backend || in.RendererThreads != this->NumberOfThreads)
     {
       const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
@@ -420,6 +428,15 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.RendererThreads = this->NumberOfThreads;
       in.BackendDescription = in.Renderer->Description();
     }
+    vtkRenderWindow* window = ren->GetRenderWindow();
+    if (this->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0)
+    {
+      this->RenderPreview(ren, width, height, 1.0 / window->GetDesiredUpdateRate());
+      this->Draw(ren, vol, *in.Preview);
+      return;
+    }
+    in.Preview.reset();
+    const mmrtm::SceneView sceneView = in.Scene.Build();
     const int accumulated = static_cast<int>(in.Film->Samples());
     const int samples = this->MaximumSamples > 0
       ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
@@ -433,21 +450,63 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
+  this->Draw(ren, vol, *in.Film);
+}
+
+void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds)
+{
+  Internals& in = *this->Internal;
+  const int f = in.PreviewFactor;
+  const int w = std::max(1, (width + f - 1) / f), h = std::max(1, (height + f - 1) / f);
+  mmrtm::RenderSettings& rs = in.Scene.render;
+  rs.width = w;
+  rs.height = h;
+  // The depth buffer at the preview's pixel centres.
+  if (!in.Depth.empty())
+  {
+    std::vector<float> depth(static_cast<size_t>(w) * h);
+    for (int row = 0; row < h; ++row)
+      for (int x = 0; x < w; ++x)
+      {
+        const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / w));
+        const int fy = std::min(height - 1, static_cast<int>((row + 0.5) * height / h));
+        depth[static_cast<size_t>(row) * w + x] = in.Depth[static_cast<size_t>(fy) * width + fx];
+      }
+    in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, depth, w, h);
+  }
+  const mmrtm::SceneView view = in.Scene.Build();
+  in.Preview = std::make_unique<mmrtm::Film>(w, h);
+  const auto start = std::chrono::steady_clock::now();
+  in.Renderer->Render(in.Scene, view, *in.Preview, 1, nullptr, nullptr);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Aim at the frame budget: coarser when too slow, finer when fast.
+  if (seconds > 1.3 * budgetSeconds && in.PreviewFactor < 16)
+    ++in.PreviewFactor;
+  else if (seconds < 0.4 * budgetSeconds && in.PreviewFactor > 1)
+    --in.PreviewFactor;
+  // The still render after the interaction starts again at full resolution.
+  in.Film.reset();
+  ++in.InteractiveRenders;
+}
+
+void vtkMultiMaterialVolumeMapper::Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
+{
   // The image: tone-mapped, premultiplied RGBA, bottom row first for OpenGL.
+  const int width = film.Width(), height = film.Height();
   std::vector<uint8_t> rgba =
-    in.Film->ToneMapped(static_cast<float>(this->Exposure), in.Scene.render.toneMapper, 4);
+    film.ToneMapped(static_cast<float>(this->Exposure), this->Internal->Scene.render.toneMapper, 4);
   const size_t row = 4 * static_cast<size_t>(width);
   for (int y = 0; y < height / 2; ++y)
     std::swap_ranges(rgba.begin() + y * row, rgba.begin() + (y + 1) * row, rgba.begin() + (height - 1 - y) * row);
 
-  // Drawn in front of everything: the camera rays already stopped at the
-  // opaque geometry, so where it is in front the image is transparent.
-  const double depth = 1e-6;
-
+  // Drawn over the whole viewport (a preview is stretched), in front of
+  // everything: the camera rays already stopped at the opaque geometry, so
+  // where it is in front the image is transparent.
+  const float depth = 1e-6f;
   vtkNew<vtkRayCastImageDisplayHelper> helper;  // the OpenGL one, through the object factory
   helper->PreMultipliedColorsOn();
   int size[2] = { width, height }, origin[2] = { 0, 0 };
-  helper->RenderTexture(vol, ren, size, size, size, origin, static_cast<float>(depth), rgba.data());
+  helper->RenderTexture(vol, ren, size, size, size, origin, depth, rgba.data());
   helper->ReleaseGraphicsResources(ren->GetRenderWindow());
 }
 

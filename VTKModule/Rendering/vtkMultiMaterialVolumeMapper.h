@@ -39,6 +39,10 @@
 #include <memory>  // for std::unique_ptr
 
 class vtkImageData;
+namespace mmrtm
+{
+class Film;
+}
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper
 {
@@ -138,6 +142,20 @@ public:
   void SetMaskTypeToLabelMap() { this->SetMaskType(LABELMAP); }
   ///@}
 
+  ///@{
+  /**
+   * While the render window asks for an interactive frame rate (its
+   * DesiredUpdateRate above 1, as vtkRenderWindowInteractor sets it while
+   * the camera moves), render a preview: 1 sample per pixel at a fraction of
+   * the resolution that adapts to the frame budget, without touching the
+   * accumulation. When the camera stops (the still update rate), the
+   * accumulation starts again at full resolution. Default on.
+   */
+  vtkSetMacro(InteractiveAdjustResolution, vtkTypeBool);
+  vtkGetMacro(InteractiveAdjustResolution, vtkTypeBool);
+  vtkBooleanMacro(InteractiveAdjustResolution, vtkTypeBool);
+  ///@}
+
   /**
    * Discards the accumulated samples; the next Render() starts again.
    */
@@ -156,6 +174,7 @@ public:
   int GetNumberOfSceneBuilds();
   int GetNumberOfRefits();
   int GetNumberOfRestarts();
+  int GetNumberOfInteractiveRenders();
   ///@}
 
   /**
@@ -178,9 +197,12 @@ protected:
   double Exposure = 1.0;
   double ShadowExtinctionScale = 0.8;
   int MaskType = LABELMAP;
+  vtkTypeBool InteractiveAdjustResolution = 1;
 
 private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
+  void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
+  void Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;
