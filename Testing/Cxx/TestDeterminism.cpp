@@ -105,3 +105,38 @@ TEST(CameraRayLimit, StopsCameraRaysOnly) {
 
 }  // namespace
 }  // namespace mmrtm
+
+namespace mmrtm {
+namespace {
+
+// Clip planes keep one side: the image of the kept half is the image of the
+// whole volume where that half is all the camera sees, and nothing elsewhere.
+TEST(ClipPlanes, KeepOneSide) {
+  Scene scene = MakeScene();
+  scene.render.integrator.backgroundVisible = false;
+  scene.camera.autoFrame = true;  // looks along +y: world x runs across the image
+  const Vec3 c = scene.proxies[0].WorldCenter();
+  const std::vector<float> whole = Render(scene, 2, 5, 1);
+  scene.clipPlanes = {ClipPlane{Vec3{1.f, 0.f, 0.f}, -c.x}};  // keep x >= centre
+  const std::vector<float> half = Render(scene, 2, 5, 1);
+  double left = 0, right = 0, wholeLeft = 0, wholeRight = 0;
+  for (int y = 0; y < 23; ++y)
+    for (int x = 0; x < 37; ++x) {
+      const size_t a = 4 * (size_t)(y * 37 + x) + 3;
+      (x < 16 ? left : right) += half[a];
+      (x < 16 ? wholeLeft : wholeRight) += whole[a];
+    }
+  ASSERT_GT(wholeLeft, 1.0);
+  ASSERT_GT(wholeRight, 1.0);
+  // One half of the image is empty, the other keeps most of its coverage.
+  EXPECT_LT(std::min(left, right), 0.05 * std::min(wholeLeft, wholeRight));
+  EXPECT_GT(std::max(left, right), 0.5 * std::max(wholeLeft, wholeRight));
+  // A plane that keeps everything changes nothing; one that keeps nothing empties the image.
+  scene.clipPlanes = {ClipPlane{Vec3{1.f, 0.f, 0.f}, 1e6f}};
+  EXPECT_EQ(Render(scene, 2, 5, 1), whole);
+  scene.clipPlanes = {ClipPlane{Vec3{1.f, 0.f, 0.f}, -1e6f}};
+  for (float v : Render(scene, 2, 5, 1)) EXPECT_EQ(v, 0.f);
+}
+
+}  // namespace
+}  // namespace mmrtm

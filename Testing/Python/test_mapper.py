@@ -12,7 +12,7 @@ import sys
 import tempfile
 import unittest
 
-from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
+from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction, vtkPlane, vtkPlaneCollection
 from vtkmodules.vtkImagingCore import vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
 from vtkmodules.vtkFiltersSources import vtkSphereSource
@@ -236,6 +236,34 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
         self.assertEqual(s.mapper.GetNumberOfInteractiveRenders(), previews)
+
+    def test_clipping_and_cropping(self):
+        s = Scene()
+        s.render()
+        whole = coverage(s.pixels())
+        # A clipping plane through the middle (world space; the normal's side stays).
+        plane = vtkPlane()
+        plane.SetOrigin(s.reader.GetOutput().GetCenter())
+        plane.SetNormal(1, 0, 0)
+        s.mapper.AddClippingPlane(plane)
+        s.render()
+        clipped = coverage(s.pixels())
+        self.assertLess(clipped, 0.8 * whole)
+        self.assertGreater(clipped, 0.2 * whole)
+        restarts = s.counts()[2]
+        plane.SetOrigin(0, 0, 0)  # editing the plane object restarts too
+        s.render()
+        self.assertEqual(s.counts()[2], restarts + 1)
+        s.mapper.RemoveAllClippingPlanes()
+        # Subvolume cropping (data coordinates): the half with the lower x only.
+        x0, x1, y0, y1, z0, z1 = s.reader.GetOutput().GetBounds()
+        s.mapper.SetCroppingRegionPlanes(x0, (x0 + x1) / 2, y0, y1, z0, z1)
+        s.mapper.SetCroppingRegionFlagsToSubVolume()
+        s.mapper.CroppingOn()
+        s.render()
+        cropped = coverage(s.pixels())
+        self.assertLess(cropped, 0.7 * whole)
+        self.assertGreater(cropped, 0.3 * whole)
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()

@@ -16,6 +16,8 @@
 #include <vtkMatrix4x4.h>
 #include <vtkObjectFactory.h>
 #include <vtkPiecewiseFunction.h>
+#include <vtkPlane.h>
+#include <vtkPlaneCollection.h>
 #include <vtkRayCastImageDisplayHelper.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -263,9 +265,14 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     vtkErrorMacro("Render: no input image or no volume property");
     return;
   }
-  if (!in.Warned && (this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND || this->Cropping))
+  if (!in.Warned && this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND)
   {
-    vtkWarningMacro("only composite blending without cropping is supported; rendering as composite");
+    vtkWarningMacro("only composite blending is supported; rendering as composite");
+    in.Warned = true;
+  }
+  if (!in.Warned && this->Cropping && this->CroppingRegionFlags != VTK_CROP_SUBVOLUME)
+  {
+    vtkWarningMacro("only the subvolume cropping region (VTK_CROP_SUBVOLUME) is supported; not cropping");
     in.Warned = true;
   }
 
@@ -384,6 +391,9 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // View: camera, lights, matrix, viewport (by value), the opaque
     // geometry (its depth), and the mapper's own settings.
     std::vector<double> view = ViewSignature(ren, vol, width, height);
+    const std::vector<mmrtm::ClipPlane> clip = this->ClipPlanes(vol);
+    for (const mmrtm::ClipPlane& p : clip)
+      view.insert(view.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
     std::vector<float> depth = ReadDepth(ren, width, height, originX, originY);
     if (!SameView(view, in.View) || depth != in.Depth || this->GetMTime() != in.MapperTime || !in.Film)
     {
@@ -405,6 +415,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.Scene.cameraRayMaxDistance =
         in.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, in.Depth, width, height);
       mmrtm::SetLightsFromVtk(ren, property, in.Scene);
+      in.Scene.clipPlanes = clip;
       mmrtm::RenderSettings& rs = in.Scene.render;
       rs.width = width;
       rs.height = height;
@@ -451,6 +462,54 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
 
   this->Draw(ren, vol, *in.Film);
+}
+
+std::vector<mmrtm::ClipPlane> vtkMultiMaterialVolumeMapper::ClipPlanes(vtkVolume* vol)
+{
+  std::vector<mmrtm::ClipPlane> planes;
+  // Clipping planes, in world space: the side the normal points to is kept.
+  if (this->ClippingPlanes)
+  {
+    this->ClippingPlanes->InitTraversal();
+    while (vtkPlane* plane = this->ClippingPlanes->GetNextItem())
+    {
+      const double* n = plane->GetNormal();
+      const double* o = plane->GetOrigin();
+      mmrtm::ClipPlane p;
+      p.normal = { static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2]) };
+      p.offset = static_cast<float>(-(n[0] * o[0] + n[1] * o[1] + n[2] * o[2]));
+      planes.push_back(p);
+    }
+  }
+  // Subvolume cropping, in the data's coordinates (before the volume's
+  // matrix): six axis-aligned half-spaces, taken to world space through the
+  // inverse transpose of the matrix.
+  if (this->Cropping && this->CroppingRegionFlags == VTK_CROP_SUBVOLUME)
+  {
+    vtkNew<vtkMatrix4x4> inverse;
+    vol->GetMatrix(inverse);
+    inverse->Invert();
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side)
+      {
+        // Data space: sign * (x[axis] - bound) >= 0.
+        const double sign = side == 0 ? 1.0 : -1.0, bound = this->CroppingRegionPlanes[2 * axis + side];
+        double n[3], d = -sign * bound;
+        for (int c = 0; c < 3; ++c)
+          n[c] = sign * inverse->GetElement(axis, c);
+        d += sign * inverse->GetElement(axis, 3);
+        mmrtm::ClipPlane p;
+        p.normal = { static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2]) };
+        p.offset = static_cast<float>(d);
+        planes.push_back(p);
+      }
+  }
+  if (static_cast<int>(planes.size()) > mmrtm::kMaxClipPlanes)
+  {
+    vtkWarningMacro("only " << mmrtm::kMaxClipPlanes << " clipping and cropping planes are used");
+    planes.resize(mmrtm::kMaxClipPlanes);
+  }
+  return planes;
 }
 
 void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds)

@@ -25,8 +25,10 @@
  * non-uniform scales render correctly. The image is composited premultiplied
  * at the depth of the volume's nearest bounding-box corner.
  *
- * Not supported yet (a warning is given once): blend modes other than
- * composite, cropping, clipping planes, more than one component.
+ * Clipping planes (world space) and subvolume cropping (data space) limit
+ * what is seen. Not supported yet (a warning is given once): blend modes
+ * other than composite, cropping regions other than the subvolume, more
+ * than one independent component.
  *
  * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
  */
@@ -37,11 +39,13 @@
 #include "vtkVolumeMapper.h"
 
 #include <memory>  // for std::unique_ptr
+#include <vector>  // for std::vector
 
 class vtkImageData;
 namespace mmrtm
 {
 class Film;
+struct ClipPlane;
 }
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper
@@ -203,6 +207,7 @@ private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
   void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
   void Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
+  std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;

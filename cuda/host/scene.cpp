@@ -263,6 +263,10 @@ SceneView Scene::Build() {
   modifiedRegions_.clear();
 
   s.camera = BuildCamera();
+  if (clipPlanes.size() > (size_t)kMaxClipPlanes)
+    throw InputError("scene: " + std::to_string(clipPlanes.size()) + " clip planes; at most " +
+                     std::to_string(kMaxClipPlanes) + " are supported");
+  for (const ClipPlane& p : clipPlanes) s.clipPlanes[s.clipPlaneCount++] = p;
   if (!cameraRayMaxDistance.empty()) {
     if (cameraRayMaxDistance.size() != (size_t)render.width * render.height)
       throw InputError("scene: cameraRayMaxDistance holds " + std::to_string(cameraRayMaxDistance.size()) +

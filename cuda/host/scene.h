@@ -99,6 +99,8 @@ class Scene {
   // which camera rays stop (opaque geometry drawn by the host application,
   // from its depth buffer; kInfinity where there is none). Empty: no limit.
   std::vector<float> cameraRayMaxDistance;
+  // Half-spaces the volume is seen in (at most kMaxClipPlanes).
+  std::vector<ClipPlane> clipPlanes;
 
   int ProxyIndex(const std::string& name) const;  // -1 if absent
   int MaterialIndex(const std::string& name) const;

@@ -29,6 +29,14 @@ struct IntegratorSettings {
   uint64_t seed = 0;
 };
 
+// A half-space that is kept: points with Dot(normal, p) + offset >= 0 (VTK's
+// clipping planes, cropping). World space.
+struct ClipPlane {
+  Vec3 normal;
+  float offset = 0.f;
+};
+constexpr int kMaxClipPlanes = 12;
+
 struct SceneView {
   Classifier classifier;
   MajorantSource majorants;
@@ -43,15 +51,35 @@ struct SceneView {
   // application drew (kInfinity where there is none). Null: no limit.
   const float* cameraRayMaxDistance = nullptr;
   IntegratorSettings settings;
+  // The volume is seen only inside every clip plane's half-space (a convex
+  // region, so each ray's part inside is one interval).
+  ClipPlane clipPlanes[kMaxClipPlanes];
+  int clipPlaneCount = 0;
 
   // The ray in proxy 0's index space, and its parametric interval inside the
-  // volume. t is the world distance along the (unit) world direction.
+  // volume and the clip planes. t is the world distance along the (unit)
+  // world direction. Every free path and transmittance goes through here.
   MMRTM_CPU_GPU bool DomainInterval(const Ray& world, float tMax, Ray* indexRay, float* t0, float* t1) const {
     const Affine3& w2i = classifier.proxies[0].worldToIndex;
     indexRay->o = w2i.ApplyPoint(world.o);
     indexRay->d = w2i.ApplyVector(world.d);
-    return IntersectBox(indexRay->o, indexRay->d, Vec3{0.f, 0.f, 0.f},
-                        Vec3{(float)(domain[0] - 1), (float)(domain[1] - 1), (float)(domain[2] - 1)}, tMax, t0, t1);
+    if (!IntersectBox(indexRay->o, indexRay->d, Vec3{0.f, 0.f, 0.f},
+                      Vec3{(float)(domain[0] - 1), (float)(domain[1] - 1), (float)(domain[2] - 1)}, tMax, t0, t1))
+      return false;
+    for (int i = 0; i < clipPlaneCount; ++i) {
+      const float along = Dot(clipPlanes[i].normal, world.d);
+      const float at0 = Dot(clipPlanes[i].normal, world.o) + clipPlanes[i].offset;  // signed distance at t = 0
+      if (along == 0.f) {
+        if (at0 < 0.f) return false;
+        continue;
+      }
+      const float t = -at0 / along;
+      if (along > 0.f)
+        *t0 = Max(*t0, t);  // entering the kept side
+      else
+        *t1 = Min(*t1, t);  // leaving it
+    }
+    return *t0 < *t1;
   }
 };
 
