@@ -1,32 +1,27 @@
-"""Renders a DICOM CT series through vtkMultiMaterialVolumeMapper with a bone
-transfer function.  Usage: render_dicom_ct.py DICOM_FOLDER [OUTPUT.png]
-(no OUTPUT: an interactive window). Run with /usr/bin/python3 and the build
-tree's package on PYTHONPATH (see Documentation/vtk-mapper.md)."""
+"""Renders a DICOM CT series through vtkMultiMaterialVolumeMapper with a preset.
+Usage: render_dicom_ct.py DICOM_FOLDER [OUTPUT.png] [PRESET]  (no OUTPUT: a window)
+Run with /usr/bin/python3 and the package on PYTHONPATH (Documentation/vtk-mapper.md)."""
 import sys
 from vtkmodules.vtkIOImage import vtkDICOMImageReader, vtkPNGWriter
-from vtkmodules.vtkRenderingCore import vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume
-from vtkmodules.vtkRenderingCore import vtkRenderWindowInteractor, vtkVolumeProperty, vtkWindowToImageFilter
-from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
+from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow, vtkRenderWindowInteractor, vtkVolume
+from vtkmodules.vtkRenderingCore import vtkVolumeProperty, vtkWindowToImageFilter
 import vtkmodules.vtkInteractionStyle, vtkmodules.vtkRenderingOpenGL2, vtkmodules.vtkRenderingVolumeOpenGL2  # noqa
-from mmrtm import vtkMultiMaterialVolumeMapper
+from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper
 
-reader = vtkDICOMImageReader()
+reader = vtkDICOMImageReader()                 # Hounsfield units, as the presets expect
 reader.SetDirectoryName(sys.argv[1])
 mapper = vtkMultiMaterialVolumeMapper()
 mapper.SetInputConnection(reader.GetOutputPort())
-opacity, color = vtkPiecewiseFunction(), vtkColorTransferFunction()  # bone, in Hounsfield units
-for hu, a, rgb in [(150, 0.0, (0.85, 0.55, 0.45)), (300, 0.5, (0.92, 0.84, 0.72)), (900, 1.0, (1, 1, 0.95))]:
-    opacity.AddPoint(hu, a)
-    color.AddRGBPoint(hu, *rgb)
-prop = vtkVolumeProperty()
-prop.SetScalarOpacity(opacity), prop.SetColor(color), prop.ShadeOn(), prop.SetAmbient(0.3)
+materials = vtkMultiMaterialProperty()
+materials.SetPreset(sys.argv[3] if len(sys.argv) > 3 else "ct-bone")   # Data/presets
+mapper.SetMultiMaterialProperty(materials)
 volume = vtkVolume()
-volume.SetMapper(mapper), volume.SetProperty(prop)
+volume.SetMapper(mapper), volume.SetProperty(vtkVolumeProperty())
 renderer = vtkRenderer()
 renderer.AddVolume(volume)
 window = vtkRenderWindow()
 window.AddRenderer(renderer), window.SetSize(400, 400)
-camera = renderer.GetActiveCamera()  # from the front: the patient's anterior side faces +y here
+camera = renderer.GetActiveCamera()            # from the front: vtkDICOMImageReader puts anterior at +y
 renderer.ResetCamera(), camera.Elevation(90), camera.OrthogonalizeViewUp(), renderer.ResetCamera()
 
 if len(sys.argv) > 2:  # off screen: accumulate 32 samples per pixel, then save

@@ -21,7 +21,7 @@ from vtkmodules.vtkRenderingCore import (vtkActor, vtkPolyDataMapper, vtkColorTr
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
 
-from mmrtm import vtkMultiMaterialVolumeMapper
+from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 BACKGROUND = (0.1, 0.1, 0.15)
@@ -264,6 +264,31 @@ class MapperTest(unittest.TestCase):
         cropped = coverage(s.pixels())
         self.assertLess(cropped, 0.7 * whole)
         self.assertGreater(cropped, 0.3 * whole)
+
+    def test_multi_material_property_with_a_preset(self):
+        s = Scene()
+        s.render()
+        before = s.pixels()
+        materials = vtkMultiMaterialProperty()
+        self.assertFalse(materials.SetPreset("no-such-preset"))
+        self.assertTrue(materials.SetPreset("ct-bone"))
+        # headsq is not in Hounsfield units (0..3926): move the preset's bone up.
+        self.assertTrue(materials.MergeSceneJSON(
+            '{"materials": {"bone": {"tfs": {"density": [{"type": "cctf", "proxy": "scalars",'
+            ' "points": [[1100, 0], [1500, 0.5], [2500, 1]]}]}}}}'))
+        s.mapper.SetMultiMaterialProperty(materials)
+        s.render()
+        builds, refits, restarts = s.counts()
+        self.assertEqual(builds, 2)
+        after = s.pixels()
+        self.assertGreater(coverage(after), 0.05)
+        self.assertGreater(mean_abs_difference(before, after), 0.005, "the preset's materials and lights show")
+        s.render()
+        self.assertEqual(s.counts(), (builds, refits, restarts), "unchanged description: samples accumulate")
+        materials.MergeSceneJSON('{"materials": {"bone": {"albedo": [0.2, 0.3, 0.9]}}}')
+        s.render()
+        self.assertEqual(s.counts()[0], builds + 1)
+        self.assertGreater(mean_abs_difference(after, s.pixels()), 0.005)
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()

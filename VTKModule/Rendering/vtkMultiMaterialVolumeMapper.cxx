@@ -32,6 +32,8 @@
 #include "mmrtmVtkSceneTranslation.h"
 #include "render_backend.h"
 #include "scene.h"
+#include "scene_json.h"
+#include "vtkMultiMaterialProperty.h"
 
 vtkStandardNewMacro(vtkMultiMaterialVolumeMapper);
 
@@ -50,6 +52,9 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::vector<mmrtm::Affine3> ImageIndexToWorld;
   mmrtm::ProxyLayout Layout;
   vtkSmartPointer<vtkImageData> Mask;
+  vtkSmartPointer<vtkMultiMaterialProperty> MultiMaterial;
+  vtkMTimeType MultiMaterialTime = 0;
+  bool LightsFromScene = false;  // the multi-material description has its own lights
   int MaskTypeBuilt = -1;
   int DependentBuilt = -1;  // components used as colour + opacity (IndependentComponents off)
 
@@ -220,6 +225,21 @@ void vtkMultiMaterialVolumeMapper::SetMaskInput(vtkImageData* mask)
   }
 }
 
+void vtkMultiMaterialVolumeMapper::SetMultiMaterialProperty(vtkMultiMaterialProperty* property)
+{
+  if (this->Internal->MultiMaterial != property)
+  {
+    this->Internal->MultiMaterial = property;
+    this->Internal->MultiMaterialTime = 0;
+    this->Modified();
+  }
+}
+
+vtkMultiMaterialProperty* vtkMultiMaterialVolumeMapper::GetMultiMaterialProperty()
+{
+  return this->Internal->MultiMaterial;
+}
+
 vtkImageData* vtkMultiMaterialVolumeMapper::GetMaskInput()
 {
   return this->Internal->Mask;
@@ -303,8 +323,16 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       !property->GetIndependentComponents() && (components == 2 || components == 4) ? components : 0;
     // 4 dependent components fill the 4 proxies: no room for a gradient.
     const bool needGradient = dependent != 4 && mmrtm::NeedsGradientProxy(property, 0, labels);
+    vtkMultiMaterialProperty* multi = in.MultiMaterial;
+    const vtkMTimeType multiTime = multi ? multi->GetMTime() : 0;
+    if (multi && multiTime != in.MultiMaterialTime)
+    {
+      // A new description: the scene is parsed again, with its proxies.
+      in.MultiMaterialTime = multiTime;
+      in.HasScene = false;
+    }
     if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
-      this->MaskType != in.MaskTypeBuilt || needGradient != (in.Layout.gradient >= 0) ||
+      this->MaskType != in.MaskTypeBuilt || (!multi && needGradient != (in.Layout.gradient >= 0)) ||
       dependent != in.DependentBuilt)
     {
       if (!in.Warned && components > 1 && !dependent)
@@ -365,9 +393,12 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
           std::to_string(scene.proxies.size()) + " proxy volumes; at most " +
           std::to_string(mmrtm::kMaxProxies) + " are supported");
-      for (const mmrtm::HostVolume& v : scene.proxies)
+      in.LightsFromScene = false;
+      if (multi)
+        this->ParseMultiMaterialScene();
+      for (const mmrtm::HostVolume& v : in.Scene.proxies)
         in.ImageIndexToWorld.push_back(v.indexToWorld);
-      scene.MarkDataModified();
+      in.Scene.MarkDataModified();
       in.Data = input;
       in.DataTime = input->GetMTime();
       in.MaskTime = maskTime;
@@ -380,7 +411,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
     // Transfer functions: translated again and refitted.
     const vtkMTimeType propertyTime = PropertyMTime(property);
-    if (propertyTime != in.PropertyTime)
+    if (!multi && propertyTime != in.PropertyTime)
     {
       mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene);
       in.PropertyTime = propertyTime;
@@ -414,7 +445,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       // and the volume in front of it hides it.
       in.Scene.cameraRayMaxDistance =
         in.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, in.Depth, width, height);
-      mmrtm::SetLightsFromVtk(ren, property, in.Scene);
+      if (!in.LightsFromScene)
+        mmrtm::SetLightsFromVtk(ren, property, in.Scene);
       in.Scene.clipPlanes = clip;
       mmrtm::RenderSettings& rs = in.Scene.render;
       rs.width = width;
@@ -462,6 +494,26 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
 
   this->Draw(ren, vol, *in.Film);
+}
+
+void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
+{
+  // The description over the mapper's volumes: its input as "scalars" (and
+  // the mask as "labels"); the camera and image size stay VTK's.
+  Internals& in = *this->Internal;
+  nlohmann::json doc = nlohmann::json::parse(in.MultiMaterial->GetSceneJSON());
+  doc.erase("camera");
+  doc.erase("volumes");  // a description's own files are not the mapper's data
+  mmrtm::SceneInputs inputs;
+  inputs.volumes["scalars"] = std::move(in.Scene.proxies[0]);
+  for (size_t i = 1; i < in.Scene.proxies.size(); ++i)
+    if (static_cast<int>(i) == in.Layout.labels || static_cast<int>(i) == in.Layout.binaryMask)
+      inputs.volumes["labels"] = std::move(in.Scene.proxies[i]);
+  in.LightsFromScene = doc.contains("lights");
+  in.Scene = mmrtm::SceneFromJson(doc, std::move(inputs));
+  in.Layout = mmrtm::ProxyLayout();
+  in.PropertyTime = 0;
+  ++in.Refits;
 }
 
 std::vector<mmrtm::ClipPlane> vtkMultiMaterialVolumeMapper::ClipPlanes(vtkVolume* vol)

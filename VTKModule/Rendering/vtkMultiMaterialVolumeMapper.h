@@ -42,6 +42,7 @@
 #include <vector>  // for std::vector
 
 class vtkImageData;
+class vtkMultiMaterialProperty;
 namespace mmrtm
 {
 class Film;
@@ -148,6 +149,17 @@ public:
 
   ///@{
   /**
+   * Materials, BSDF parameters, material transfer functions, lights and
+   * presets beyond what vtkVolumeProperty can say. When set, it replaces the
+   * translation of the volume property (whose functions are then not used);
+   * null (the default) translates the volume property.
+   */
+  void SetMultiMaterialProperty(vtkMultiMaterialProperty* property);
+  vtkMultiMaterialProperty* GetMultiMaterialProperty();
+  ///@}
+
+  ///@{
+  /**
    * While the render window asks for an interactive frame rate (its
    * DesiredUpdateRate above 1, as vtkRenderWindowInteractor sets it while
    * the camera moves), render a preview: 1 sample per pixel at a fraction of
@@ -208,6 +220,7 @@ private:
   void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
   void Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
+  void ParseMultiMaterialScene();
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;
