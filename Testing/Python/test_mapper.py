@@ -12,11 +12,12 @@ import sys
 import tempfile
 import unittest
 
-from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction, vtkPlane, vtkPlaneCollection
+from vtkmodules.vtkCommonCore import vtkFloatArray
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction, vtkPlane, vtkPlaneCollection
 from vtkmodules.vtkImagingCore import vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
 from vtkmodules.vtkFiltersSources import vtkSphereSource
-from vtkmodules.vtkRenderingCore import (vtkActor, vtkPolyDataMapper, vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
+from vtkmodules.vtkRenderingCore import (vtkActor, vtkTexture, vtkPolyDataMapper, vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
                                          vtkVolumeProperty, vtkWindowToImageFilter)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
@@ -289,6 +290,34 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(s.counts()[0], builds + 1)
         self.assertGreater(mean_abs_difference(after, s.pixels()), 0.005)
+
+    def test_environment_texture_lights_the_volume(self):
+        s = Scene()
+        s.render()
+
+        def blueness(pixels):
+            return sum(pixels[i + 2] - pixels[i] for i in range(0, len(pixels), 3)) / (len(pixels) / 3)
+
+        plain = blueness(s.pixels())
+        # An equirectangular sky: strong blue everywhere (float = linear radiance).
+        sky = vtkImageData()
+        sky.SetDimensions(32, 16, 1)
+        texels = vtkFloatArray()
+        texels.SetNumberOfComponents(3)
+        for _ in range(32 * 16):
+            texels.InsertNextTuple3(0.1, 0.3, 3.0)
+        sky.GetPointData().SetScalars(texels)
+        texture = vtkTexture()
+        texture.SetInputData(sky)
+        s.mapper.SetEnvironmentTexture(texture)
+        restarts = s.counts()[2]
+        s.render()
+        self.assertEqual(s.counts()[2], restarts + 1)
+        lit = blueness(s.pixels())
+        self.assertGreater(lit, plain + 2, "a blue sky makes the volume bluer")
+        s.mapper.SetEnvironmentIntensity(0.0)
+        s.render()
+        self.assertLess(blueness(s.pixels()), lit - 2)
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()

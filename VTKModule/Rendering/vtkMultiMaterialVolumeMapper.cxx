@@ -21,6 +21,8 @@
 #include <vtkRayCastImageDisplayHelper.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkPointData.h>
+#include <vtkTexture.h>
 #include <vtkSmartPointer.h>
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
@@ -55,6 +57,10 @@ struct vtkMultiMaterialVolumeMapper::Internals
   vtkSmartPointer<vtkMultiMaterialProperty> MultiMaterial;
   vtkMTimeType MultiMaterialTime = 0;
   bool LightsFromScene = false;  // the multi-material description has its own lights
+  vtkSmartPointer<vtkTexture> EnvironmentTexture;
+  std::shared_ptr<mmrtm::EnvironmentMap> Environment;  // converted from the texture
+  vtkMTimeType EnvironmentTime = 0;
+  double EnvironmentScale = 0;
   int MaskTypeBuilt = -1;
   int DependentBuilt = -1;  // components used as colour + opacity (IndependentComponents off)
 
@@ -240,6 +246,20 @@ vtkMultiMaterialProperty* vtkMultiMaterialVolumeMapper::GetMultiMaterialProperty
   return this->Internal->MultiMaterial;
 }
 
+void vtkMultiMaterialVolumeMapper::SetEnvironmentTexture(vtkTexture* texture)
+{
+  if (this->Internal->EnvironmentTexture != texture)
+  {
+    this->Internal->EnvironmentTexture = texture;
+    this->Modified();
+  }
+}
+
+vtkTexture* vtkMultiMaterialVolumeMapper::GetEnvironmentTexture()
+{
+  return this->Internal->EnvironmentTexture;
+}
+
 vtkImageData* vtkMultiMaterialVolumeMapper::GetMaskInput()
 {
   return this->Internal->Mask;
@@ -423,6 +443,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // geometry (its depth), and the mapper's own settings.
     std::vector<double> view = ViewSignature(ren, vol, width, height);
     const std::vector<mmrtm::ClipPlane> clip = this->ClipPlanes(vol);
+    this->UpdateEnvironment();
+    view.push_back(static_cast<double>(in.EnvironmentTime));
     for (const mmrtm::ClipPlane& p : clip)
       view.insert(view.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
     std::vector<float> depth = ReadDepth(ren, width, height, originX, originY);
@@ -447,6 +469,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         in.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, in.Depth, width, height);
       if (!in.LightsFromScene)
         mmrtm::SetLightsFromVtk(ren, property, in.Scene);
+      if (in.Environment)
+        in.Scene.environment = in.Environment;
       in.Scene.clipPlanes = clip;
       mmrtm::RenderSettings& rs = in.Scene.render;
       rs.width = width;
@@ -494,6 +518,52 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
 
   this->Draw(ren, vol, *in.Film);
+}
+
+void vtkMultiMaterialVolumeMapper::UpdateEnvironment()
+{
+  Internals& in = *this->Internal;
+  vtkTexture* texture = in.EnvironmentTexture;
+  vtkImageData* image = texture ? vtkImageData::SafeDownCast(texture->GetInput()) : nullptr;
+  if (texture && texture->GetInputAlgorithm())
+  {
+    texture->GetInputAlgorithm()->Update();
+    image = vtkImageData::SafeDownCast(texture->GetInput());
+  }
+  const vtkMTimeType time = image ? std::max(image->GetMTime(), texture->GetMTime()) : 0;
+  if (time == in.EnvironmentTime && this->EnvironmentIntensity == in.EnvironmentScale)
+    return;
+  in.EnvironmentTime = time;
+  in.EnvironmentScale = this->EnvironmentIntensity;
+  in.Environment.reset();
+  if (!image)
+    return;
+  vtkDataArray* a = image->GetPointData()->GetScalars();
+  const int* d = image->GetDimensions();
+  if (!a || a->GetNumberOfComponents() < 3 || d[2] != 1 || d[0] < 1 || d[1] < 1)
+  {
+    vtkErrorMacro("the environment texture needs a 2D image with 3 or 4 components");
+    return;
+  }
+  // sRGB bytes to linear; float data is radiance already. VTK's rows run
+  // bottom up, the environment's from the zenith down.
+  const bool bytes = a->GetDataType() == VTK_UNSIGNED_CHAR;
+  auto linear = [bytes](double v) {
+    if (!bytes)
+      return static_cast<float>(std::max(v, 0.0));
+    v /= 255.0;
+    return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+  };
+  std::vector<mmrtm::RGB> texels(static_cast<size_t>(d[0]) * d[1]);
+  const float scale = static_cast<float>(this->EnvironmentIntensity);
+  for (int y = 0; y < d[1]; ++y)
+    for (int x = 0; x < d[0]; ++x)
+    {
+      const vtkIdType i = x + static_cast<vtkIdType>(d[0]) * (d[1] - 1 - y);
+      texels[static_cast<size_t>(y) * d[0] + x] = mmrtm::RGB(linear(a->GetComponent(i, 0)) * scale,
+        linear(a->GetComponent(i, 1)) * scale, linear(a->GetComponent(i, 2)) * scale);
+    }
+  in.Environment = std::make_shared<mmrtm::EnvironmentMap>(d[0], d[1], std::move(texels));
 }
 
 void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()

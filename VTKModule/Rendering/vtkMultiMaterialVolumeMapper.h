@@ -43,6 +43,7 @@
 
 class vtkImageData;
 class vtkMultiMaterialProperty;
+class vtkTexture;
 namespace mmrtm
 {
 class Film;
@@ -160,6 +161,20 @@ public:
 
   ///@{
   /**
+   * An environment light: an equirectangular image (its input vtkImageData,
+   * 3 or 4 components; float data is linear radiance, unsigned char is
+   * sRGB), the top row toward +z (superior), times EnvironmentIntensity. It
+   * replaces the ambient term, and is lit in addition to the lights. Null
+   * (the default): no environment texture.
+   */
+  void SetEnvironmentTexture(vtkTexture* texture);
+  vtkTexture* GetEnvironmentTexture();
+  vtkSetClampMacro(EnvironmentIntensity, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(EnvironmentIntensity, double);
+  ///@}
+
+  ///@{
+  /**
    * While the render window asks for an interactive frame rate (its
    * DesiredUpdateRate above 1, as vtkRenderWindowInteractor sets it while
    * the camera moves), render a preview: 1 sample per pixel at a fraction of
@@ -214,6 +229,7 @@ protected:
   double ShadowExtinctionScale = 0.8;
   int MaskType = LABELMAP;
   vtkTypeBool InteractiveAdjustResolution = 1;
+  double EnvironmentIntensity = 1.0;
 
 private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
@@ -221,6 +237,7 @@ private:
   void Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
+  void UpdateEnvironment();
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;
