@@ -355,64 +355,13 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       this->MaskType != in.MaskTypeBuilt || (!multi && needGradient != (in.Layout.gradient >= 0)) ||
       dependent != in.DependentBuilt)
     {
+      in.HasScene = false;  // until the rebuild succeeds
       if (!in.Warned && components > 1 && !dependent)
       {
         vtkWarningMacro("only component 0 of " << components << " independent components is rendered");
         in.Warned = true;
       }
-      mmrtm::Scene& scene = in.Scene;
-      scene.proxies.clear();
-      in.ImageIndexToWorld.clear();
-      in.Layout = mmrtm::ProxyLayout();
-      auto component = [&](int c, const char* name) {
-        scene.proxies.push_back(
-          mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
-        return static_cast<int>(scene.proxies.size()) - 1;
-      };
-      component(0, dependent == 4 ? "red" : "scalars");
-      in.Layout.scalarRange = scene.proxies[0].ValueRange();
-      scene.gradientProxy = 0;
-      if (dependent == 2)
-      {
-        in.Layout.opacity = component(1, "opacity");
-      }
-      else if (dependent == 4)
-      {
-        in.Layout.rgb[0] = 0;
-        in.Layout.rgb[1] = component(1, "green");
-        in.Layout.rgb[2] = component(2, "blue");
-        in.Layout.opacity = component(3, "opacity");
-        float top = 0.f;
-        for (int c = 0; c < 3; ++c)
-          top = std::max(top, scene.proxies[c].ValueRange()[1]);
-        in.Layout.colorScale = scalars->GetDataType() == VTK_UNSIGNED_CHAR ? 255.f : std::max(top, 1e-6f);
-      }
-      if (in.Layout.opacity >= 0)
-      {
-        in.Layout.opacityRange = scene.proxies[in.Layout.opacity].ValueRange();
-        scene.gradientProxy = in.Layout.opacity;  // VTK shades dependent data by the opacity component
-      }
-      if (needGradient)
-      {
-        const int source = scene.gradientProxy;
-        in.Layout.gradient = static_cast<int>(scene.proxies.size());
-        scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[source], "gradient"));
-        in.Layout.gradientRange = scene.proxies.back().ValueRange();
-      }
-      if (mask)
-      {
-        // Labels are never interpolated; a mask on another grid is put on
-        // the input's by nearest neighbour in world space.
-        mmrtm::HostVolume m = mmrtm::ImageDataToHostVolume(
-          mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
-        m = mmrtm::AlignLabelsToVolume(std::move(m), scene.proxies[0]);
-        (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
-        scene.proxies.push_back(std::move(m));
-      }
-      if (scene.proxies.size() > mmrtm::kMaxProxies)
-        throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
-          std::to_string(scene.proxies.size()) + " proxy volumes; at most " +
-          std::to_string(mmrtm::kMaxProxies) + " are supported");
+      this->BuildProxies(input, scalars, dependent, needGradient, labels);
       in.LightsFromScene = false;
       if (multi)
         this->ParseMultiMaterialScene();
@@ -518,6 +467,68 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
 
   this->Draw(ren, vol, *in.Film);
+}
+
+// The proxies of the input (its components as the property uses them), the
+// gradient magnitude when some function reads it, and the mask.
+void vtkMultiMaterialVolumeMapper::BuildProxies(
+  vtkImageData* input, vtkDataArray* scalars, int dependent, bool needGradient, bool labels)
+{
+  Internals& in = *this->Internal;
+  vtkImageData* mask = in.Mask;
+  mmrtm::Scene& scene = in.Scene;
+  scene.proxies.clear();
+  in.ImageIndexToWorld.clear();
+  in.Layout = mmrtm::ProxyLayout();
+  auto component = [&](int c, const char* name) {
+    scene.proxies.push_back(
+      mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
+    return static_cast<int>(scene.proxies.size()) - 1;
+  };
+  component(0, dependent == 4 ? "red" : "scalars");
+  in.Layout.scalarRange = scene.proxies[0].ValueRange();
+  scene.gradientProxy = 0;
+  if (dependent == 2)
+  {
+    in.Layout.opacity = component(1, "opacity");
+  }
+  else if (dependent == 4)
+  {
+    in.Layout.rgb[0] = 0;
+    in.Layout.rgb[1] = component(1, "green");
+    in.Layout.rgb[2] = component(2, "blue");
+    in.Layout.opacity = component(3, "opacity");
+    float top = 0.f;
+    for (int c = 0; c < 3; ++c)
+      top = std::max(top, scene.proxies[c].ValueRange()[1]);
+    in.Layout.colorScale = scalars->GetDataType() == VTK_UNSIGNED_CHAR ? 255.f : std::max(top, 1e-6f);
+  }
+  if (in.Layout.opacity >= 0)
+  {
+    in.Layout.opacityRange = scene.proxies[in.Layout.opacity].ValueRange();
+    scene.gradientProxy = in.Layout.opacity;  // VTK shades dependent data by the opacity component
+  }
+  if (needGradient)
+  {
+    const int source = scene.gradientProxy;
+    in.Layout.gradient = static_cast<int>(scene.proxies.size());
+    scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[source], "gradient"));
+    in.Layout.gradientRange = scene.proxies.back().ValueRange();
+  }
+  if (mask)
+  {
+    // Labels are never interpolated; a mask on another grid is put on
+    // the input's by nearest neighbour in world space.
+    mmrtm::HostVolume m = mmrtm::ImageDataToHostVolume(
+      mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
+    m = mmrtm::AlignLabelsToVolume(std::move(m), scene.proxies[0]);
+    (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
+    scene.proxies.push_back(std::move(m));
+  }
+  if (scene.proxies.size() > mmrtm::kMaxProxies)
+    throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
+      std::to_string(scene.proxies.size()) + " proxy volumes; at most " +
+      std::to_string(mmrtm::kMaxProxies) + " are supported");
 }
 
 void vtkMultiMaterialVolumeMapper::UpdateEnvironment()

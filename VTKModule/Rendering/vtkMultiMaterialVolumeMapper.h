@@ -41,6 +41,7 @@
 #include <memory>  // for std::unique_ptr
 #include <vector>  // for std::vector
 
+class vtkDataArray;
 class vtkImageData;
 class vtkMultiMaterialProperty;
 class vtkTexture;
@@ -238,6 +239,7 @@ private:
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
   void UpdateEnvironment();
+  void BuildProxies(vtkImageData* input, vtkDataArray* scalars, int dependent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;
