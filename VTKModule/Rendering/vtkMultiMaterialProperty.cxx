@@ -29,65 +29,56 @@ std::string vtkMultiMaterialProperty::GetPresetDirectory()
   return std::string(MMRTM_DATA_DIR) + "/presets";
 }
 
-bool vtkMultiMaterialProperty::SetPreset(const char* name)
+namespace
 {
+// Runs `change` on the document; an exception (a missing file, bad JSON)
+// becomes a VTK error naming the problem, and the document stays as it was.
+template <typename Change>
+bool ChangeDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, Change change)
+{
+  nlohmann::json next = document;
   try
   {
-    this->Internal->Document =
-      mmrtm::ReadJsonFile(mmrtm::PresetPath(GetPresetDirectory(), name ? name : ""));
+    change(next);
   }
   catch (const std::exception& e)
   {
-    vtkErrorMacro(<< e.what());
+    vtkErrorWithObjectMacro(self, << e.what());
     return false;
   }
-  this->Modified();
+  document = std::move(next);
+  self->Modified();
   return true;
+}
+
+nlohmann::json ParseJson(const char* text)
+{
+  return nlohmann::json::parse(text ? text : "", nullptr, true, true);
+}
+}
+
+bool vtkMultiMaterialProperty::SetPreset(const char* name)
+{
+  return ChangeDocument(this, this->Internal->Document, [name](nlohmann::json& doc) {
+    doc = mmrtm::ReadJsonFile(mmrtm::PresetPath(GetPresetDirectory(), name ? name : ""));
+  });
 }
 
 bool vtkMultiMaterialProperty::SetSceneFile(const char* path)
 {
-  try
-  {
-    this->Internal->Document = mmrtm::ReadJsonFile(path ? path : "");
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro(<< e.what());
-    return false;
-  }
-  this->Modified();
-  return true;
+  return ChangeDocument(
+    this, this->Internal->Document, [path](nlohmann::json& doc) { doc = mmrtm::ReadJsonFile(path ? path : ""); });
 }
 
 bool vtkMultiMaterialProperty::SetSceneJSON(const char* text)
 {
-  try
-  {
-    this->Internal->Document = nlohmann::json::parse(text ? text : "", nullptr, true, true);
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("not JSON: " << e.what());
-    return false;
-  }
-  this->Modified();
-  return true;
+  return ChangeDocument(this, this->Internal->Document, [text](nlohmann::json& doc) { doc = ParseJson(text); });
 }
 
 bool vtkMultiMaterialProperty::MergeSceneJSON(const char* text)
 {
-  try
-  {
-    this->Internal->Document.merge_patch(nlohmann::json::parse(text ? text : "", nullptr, true, true));
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("not JSON: " << e.what());
-    return false;
-  }
-  this->Modified();
-  return true;
+  return ChangeDocument(
+    this, this->Internal->Document, [text](nlohmann::json& doc) { doc.merge_patch(ParseJson(text)); });
 }
 
 std::string vtkMultiMaterialProperty::GetSceneJSON()
