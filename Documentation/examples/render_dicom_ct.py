@@ -2,14 +2,14 @@
 Usage: render_dicom_ct.py DICOM_FOLDER [OUTPUT.png] [PRESET]  (no OUTPUT: a window)
 Run with /usr/bin/python3 and the package on PYTHONPATH (Documentation/vtk-mapper.md)."""
 import sys
-from vtkmodules.vtkIOImage import vtkDICOMImageReader, vtkPNGWriter
+from vtkmodules.vtkIOImage import vtkPNGWriter
 from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow, vtkRenderWindowInteractor, vtkVolume
 from vtkmodules.vtkRenderingCore import vtkVolumeProperty, vtkWindowToImageFilter
 import vtkmodules.vtkInteractionStyle, vtkmodules.vtkRenderingOpenGL2, vtkmodules.vtkRenderingVolumeOpenGL2  # noqa
-from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper
+from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
-reader = vtkDICOMImageReader()                 # Hounsfield units, as the presets expect
-reader.SetDirectoryName(sys.argv[1])
+reader = vtkMultiMaterialVolumeReader()        # ITK/GDCM: any transfer syntax, Hounsfield units, LPS
+reader.SetFileName(sys.argv[1])
 mapper = vtkMultiMaterialVolumeMapper()
 mapper.SetInputConnection(reader.GetOutputPort())
 materials = vtkMultiMaterialProperty()
@@ -21,8 +21,8 @@ renderer = vtkRenderer()
 renderer.AddVolume(volume)
 window = vtkRenderWindow()
 window.AddRenderer(renderer), window.SetSize(400, 400)
-camera = renderer.GetActiveCamera()            # from the front: vtkDICOMImageReader puts anterior at +y
-renderer.ResetCamera(), camera.Elevation(90), camera.OrthogonalizeViewUp(), renderer.ResetCamera()
+camera = renderer.GetActiveCamera()            # from the front (anterior is -y in LPS), head up
+camera.SetPosition(0, -1, 0), camera.SetFocalPoint(0, 0, 0), camera.SetViewUp(0, 0, 1), renderer.ResetCamera()
 
 if len(sys.argv) > 2:  # off screen: accumulate 32 samples per pixel, then save
     window.SetOffScreenRendering(1)

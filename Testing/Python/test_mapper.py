@@ -22,7 +22,7 @@ from vtkmodules.vtkRenderingCore import (vtkActor, vtkTexture, vtkPolyDataMapper
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
 
-from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper
+from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 BACKGROUND = (0.1, 0.1, 0.15)
@@ -324,6 +324,26 @@ class MapperTest(unittest.TestCase):
         a.render()
         b.render()
         self.assertEqual(a.pixels(), b.pixels())
+
+
+class ReaderTest(unittest.TestCase):
+    def test_reads_a_jpeg2000_dicom_series_in_hounsfield_units(self):
+        reader = vtkMultiMaterialVolumeReader()
+        reader.SetFileName(os.path.join(DATA, "ct_abdomen_dicom_j2k"))
+        reader.Update()
+        image = reader.GetOutput()
+        self.assertEqual(image.GetDimensions(), (512, 512, 20))
+        self.assertAlmostEqual(image.GetSpacing()[2], 2.0, places=3)  # from the positions, not SliceThickness
+        low, high = image.GetScalarRange()
+        self.assertLessEqual(low, -1000)  # air in Hounsfield units
+        self.assertGreater(high, 500)
+        self.assertEqual(reader.GetWarnings(), "")
+
+    def test_a_missing_file_is_an_error_not_a_crash(self):
+        reader = vtkMultiMaterialVolumeReader()
+        reader.SetFileName(os.path.join(DATA, "no_such_volume.nrrd"))
+        reader.Update()
+        self.assertEqual(reader.GetOutput().GetNumberOfPoints(), 0)
 
 
 class ExampleTest(unittest.TestCase):
