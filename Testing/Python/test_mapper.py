@@ -319,6 +319,43 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertLess(blueness(s.pixels()), lit - 2)
 
+    def test_2d_transfer_function(self):
+        s = Scene()
+
+        def table(alpha_of, rgb):
+            # x: scalar 0..4000 in 41 columns; y: gradient magnitude 0..1000 in 11 rows.
+            image = vtkImageData()
+            image.SetDimensions(41, 11, 1)
+            image.SetOrigin(0, 0, 0)
+            image.SetSpacing(100, 100, 1)
+            values = vtkFloatArray()
+            values.SetNumberOfComponents(4)
+            for j in range(11):
+                for i in range(41):
+                    values.InsertNextTuple4(*rgb, alpha_of(100.0 * i, 100.0 * j))
+            image.GetPointData().SetScalars(values)
+            return image
+
+        s.property.SetTransferFunction2D(table(lambda x, g: 0.0, (1, 1, 1)))
+        s.property.SetTransferFunctionMode(1)  # vtkVolumeProperty.TF_2D
+        s.render()
+        self.assertLess(coverage(s.pixels()), 0.01, "a 2D function without opacity shows nothing")
+        # Bone (scalar >= 1500) at every gradient, green.
+        bone = table(lambda x, g: 0.9 if x >= 1500 else 0.0, (0.1, 0.9, 0.2))
+        s.property.SetTransferFunction2D(bone)
+        refits = s.counts()[1]
+        s.render()
+        self.assertEqual(s.counts()[1], refits + 1)
+        pixels = s.pixels()
+        self.assertGreater(coverage(pixels), 0.05)
+        green = sum(1 for i in range(0, len(pixels), 3) if pixels[i + 1] > pixels[i] + 20)
+        self.assertGreater(green, 0.5 * coverage(pixels) * len(pixels) / 3, "the 2D colours show")
+        # Only where the gradient is small (inside the bone, not its surface):
+        # less is seen than with every gradient.
+        s.property.SetTransferFunction2D(table(lambda x, g: 0.9 if x >= 1500 and g < 100 else 0.0, (0.1, 0.9, 0.2)))
+        s.render()
+        self.assertLess(coverage(s.pixels()), coverage(pixels))
+
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()
         a.render()

@@ -7,7 +7,10 @@
 
 #include <vtkCamera.h>
 #include <vtkColorTransferFunction.h>
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
 #include <vtkLight.h>
+#include <vtkPointData.h>
 #include <vtkLightCollection.h>
 #include <vtkPiecewiseFunction.h>
 #include <vtkRenderer.h>
@@ -139,13 +142,88 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
 
 }  // namespace
 
+// The property's 2D transfer function, when it is the one in use.
+vtkImageData* TransferFunction2D(vtkVolumeProperty* property, int component) {
+  if (property->GetTransferFunctionMode() != vtkVolumeProperty::TF_2D) return nullptr;
+  vtkImageData* f = property->GetTransferFunction2D(component);
+  if (!f || !f->GetPointData()->GetScalars() || f->GetPointData()->GetScalars()->GetNumberOfComponents() != 4)
+    return nullptr;
+  return f;
+}
+
 bool NeedsGradientProxy(vtkVolumeProperty* property, int component, bool labels) {
-  if (UsesGradientOpacity(property, component)) return true;
+  if (UsesGradientOpacity(property, component) || TransferFunction2D(property, component)) return true;
   if (labels)
     for (int label : property->GetLabelMapLabels())
       if (!IsConstantOne(property->GetLabelGradientOpacity(label))) return true;
   return false;
 }
+
+namespace {
+
+// A 2D transfer function (x: scalar value, y: gradient magnitude, RGBA) as
+// materials: the scalar axis is cut into at most kMax2DBands bands, each a
+// material whose extinction and albedo are CCTFs over the gradient
+// magnitude (the band's mean over its columns), chosen by an MPCTF over the
+// scalars. Exact in the gradient direction; in the scalar direction the
+// table is piecewise constant per band (one band per column up to 64
+// columns), where VTK interpolates between columns.
+constexpr int kMax2DBands = 64;
+
+void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
+                    Scene& scene) {
+  int dims[3];
+  table->GetDimensions(dims);
+  double origin[3], spacing[3];
+  table->GetOrigin(origin);
+  table->GetSpacing(spacing);
+  vtkDataArray* rgba = table->GetPointData()->GetScalars();
+  const int nx = dims[0], ny = dims[1];
+  const int bands = std::min(nx, kMax2DBands);
+  const double unit = std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
+  std::vector<float> g(ny);
+  for (int j = 0; j < ny; ++j) g[j] = (float)(origin[1] + j * spacing[1]);
+  if (ny == 1) g.push_back(g[0] + 1.f);  // a constant in the gradient: two equal points
+  TransferFunctionDesc selector;
+  selector.where = "2D transfer function";
+  selector.type = TFType::MPCTF;
+  selector.proxy = 0;
+  selector.channels = 1;
+  for (int b = 0; b < bands; ++b) {
+    const int i0 = b * nx / bands, i1 = (b + 1) * nx / bands;  // columns [i0, i1)
+    std::vector<float> density, albedo;
+    for (int j = 0; j < (int)g.size(); ++j) {
+      const int row = std::min(j, ny - 1);
+      double sum[4] = {0, 0, 0, 0};
+      for (int i = i0; i < i1; ++i)
+        for (int c = 0; c < 4; ++c) sum[c] += rgba->GetComponent(i + (vtkIdType)nx * row, c) / (i1 - i0);
+      density.push_back((float)(-std::log(1.0 - std::clamp(sum[3], 0.0, 0.9999)) / unit));
+      for (int c = 0; c < 3; ++c) albedo.push_back((float)std::clamp(sum[c], 0.0, 1.0));
+    }
+    // The band covers its columns' cells: from half a column below the
+    // first to half a column above the last (the outer bands extend far).
+    const double lo = b == 0 ? -1e30 : origin[0] + (i0 - 0.5) * spacing[0];
+    const double hi = b == bands - 1 ? 1e30 : origin[0] + (i1 - 0.5) * spacing[0];
+    MaterialDesc m;
+    m.name = "2D band " + std::to_string(b);
+    m.base[QuantityOffset(Quantity::Density)] = 1.f;
+    m.bindings.push_back({AddCurve(scene, m.name + " opacity", proxies.gradient, g, density, 1), Quantity::Density});
+    m.bindings.push_back({AddCurve(scene, m.name + " color", proxies.gradient, g, albedo, 3), Quantity::Albedo});
+    const bool shade = property->GetShade(component) != 0;
+    m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
+    const double specular = property->GetSpecular(component), power = std::max(property->GetSpecularPower(component), 0.0);
+    m.base[QuantityOffset(Quantity::Roughness)] =
+        specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
+    selector.keys.push_back((float)lo);
+    selector.keys.push_back((float)hi);
+    selector.materials.push_back((int)scene.materials.size());
+    scene.materials.push_back(std::move(m));
+  }
+  scene.tfs.push_back(std::move(selector));
+  scene.selectors.push_back((int)scene.tfs.size() - 1);
+}
+
+}  // namespace
 
 void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
   scene.tfs.clear();
@@ -158,8 +236,13 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
   else
     main.grey = property->GetGrayTransferFunction(component);
   if (UsesGradientOpacity(property, component)) main.gradientOpacity = property->GetGradientOpacity(component);
-  scene.materials.push_back(MakeMaterial("volume", main, property, component, proxies, scene));
-  scene.defaultMaterial = 0;
+  if (vtkImageData* table = TransferFunction2D(property, component); table && proxies.gradient >= 0) {
+    Add2DMaterials(table, property, component, proxies, scene);  // no default: outside the bands is empty
+    scene.defaultMaterial = kNoMaterial;
+  } else {
+    scene.materials.push_back(MakeMaterial("volume", main, property, component, proxies, scene));
+    scene.defaultMaterial = 0;
+  }
 
   // Labels: a material each, picked by an MDPTF over the label map.
   if (proxies.labels < 0) return;
@@ -180,7 +263,7 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
   }
   if (selector.keys.empty()) return;
   scene.tfs.push_back(std::move(selector));
-  scene.selectors.push_back((int)scene.tfs.size() - 1);
+  scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1);  // labels first
 }
 
 void SetCameraFromVtk(vtkCamera* camera, Scene& scene) {

@@ -85,6 +85,8 @@ namespace
 vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
 {
   vtkMTimeType t = p->GetMTime();
+  if (vtkImageData* table = p->GetTransferFunction2D(0))
+    t = std::max(t, table->GetMTime());
   for (int label : p->GetLabelMapLabels())
   {
     if (vtkPiecewiseFunction* f = p->GetLabelScalarOpacity(label))
