@@ -107,7 +107,7 @@ float Scene::GlobalMajorant() const {
       tf.MaxOverRange(ranges[tf.proxy][0], ranges[tf.proxy][1], maxValue);
       d *= maxValue[0];
     }
-    majorant = std::max(majorant, d);
+    majorant = additiveMaterials ? majorant + d : std::max(majorant, d);  // a mixture's extinctions add up
   }
   return majorant;
 }
@@ -236,6 +236,7 @@ SceneView Scene::Build() {
   c.selectorCount = (int)selectors.size();
   c.defaultMaterial = defaultMaterial;
   c.gradientProxy = gradientProxy;
+  c.additive = additiveMaterials;
   for (int a = 0; a < 3; ++a) s.domain[a] = proxies[0].dims[a];
 
   c.tfCount = (int)tfViews_.size();

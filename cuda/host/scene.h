@@ -83,6 +83,8 @@ class Scene {
   std::vector<int> selectors;  // material TFs (indexes into tfs), highest priority first
   int defaultMaterial = kNoMaterial;
   int gradientProxy = 0;
+  // Every material present at once, extinctions added (Classifier::additive).
+  bool additiveMaterials = false;
   std::vector<Light> lights;  // directional and point lights
   // Directional lights placed relative to the camera: from the direction
   // toward the camera, turned `azimuth` degrees to the camera's right and

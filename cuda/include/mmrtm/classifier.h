@@ -40,6 +40,12 @@ struct Classifier {
   int selectorCount = 0;
   int defaultMaterial = kNoMaterial;
   int gradientProxy = 0;  // whose gradient gives the surface normal
+  // Additive merge (VTK's independent components): every material is
+  // present at once, as a mixture of particles. sigma_t is the sum of the
+  // materials' extinctions, and the other coefficients are their means
+  // weighted by extinction (the collision's particle is of material m with
+  // probability sigma_m / sigma_t). Material TFs and the default are unused.
+  bool additive = false;
 
   MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world) const {
     ProxySamples s;
@@ -63,6 +69,11 @@ struct Classifier {
   MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
     Classification c;
     c.proxies = SampleProxies(world);
+    if (additive) {
+      for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
+      c.material = c.sigma_t > 0.f ? 0 : kNoMaterial;  // a mixture: see Coefficients
+      return c;
+    }
     for (int i = 0; i < selectorCount; ++i) {
       const TransferFunctionView& tf = tfs[selectors[i]];
       int m = tf.EvaluateMaterial(c.proxies.v[tf.proxy]);
@@ -81,20 +92,39 @@ struct Classifier {
     return c;
   }
 
-  // All coefficients of the classified material (at real collisions only).
-  MMRTM_CPU_GPU MaterialCoefficients Coefficients(const Classification& c) const {
-    MaterialCoefficients out;
-    if (c.material == kNoMaterial) return out;
-    const MaterialView& mat = materials[c.material];
-    float k[kCoefficientFloats];
+  // Material m's coefficients (base times its coefficient TFs) at the
+  // sampled proxy values, the density slot excepted.
+  MMRTM_CPU_GPU void MaterialCoefficientArray(int m, const ProxySamples& s, float* k) const {
+    const MaterialView& mat = materials[m];
     for (int i = 0; i < kCoefficientFloats; ++i) k[i] = mat.base[i];
     for (int b = mat.densityBindingCount; b < mat.bindingCount; ++b) {
       const CoefficientBinding& bind = bindings[mat.bindingBegin + b];
       const TransferFunctionView& tf = tfs[bind.tf];
       float v[kMaxTFChannels];
-      tf.Evaluate(c.proxies.v[tf.proxy], v);
+      tf.Evaluate(s.v[tf.proxy], v);
       int offset = QuantityOffset(bind.quantity), n = QuantityChannels(bind.quantity);
       for (int ch = 0; ch < n; ++ch) k[offset + ch] *= v[tf.channels == 1 ? 0 : ch];
+    }
+  }
+
+  // All coefficients of the classified material (at real collisions only).
+  MMRTM_CPU_GPU MaterialCoefficients Coefficients(const Classification& c) const {
+    MaterialCoefficients out;
+    if (c.material == kNoMaterial) return out;
+    float k[kCoefficientFloats];
+    if (additive) {
+      // The mixture: each material's coefficients weighted by its share of sigma_t.
+      for (int i = 0; i < kCoefficientFloats; ++i) k[i] = 0.f;
+      for (int m = 0; m < materialCount; ++m) {
+        const float d = Density(m, c.proxies);
+        if (!(d > 0.f)) continue;
+        float km[kCoefficientFloats];
+        MaterialCoefficientArray(m, c.proxies, km);
+        const float w = d / c.sigma_t;
+        for (int i = 0; i < kCoefficientFloats; ++i) k[i] += w * km[i];
+      }
+    } else {
+      MaterialCoefficientArray(c.material, c.proxies, k);
     }
     out.sigma_t = c.sigma_t;
     out.albedo = RGB(Clamp(k[1], 0.f, 1.f), Clamp(k[2], 0.f, 1.f), Clamp(k[3], 0.f, 1.f));

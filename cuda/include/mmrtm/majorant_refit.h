@@ -44,7 +44,7 @@ struct RefitInputs {
 // it (the default, and whatever a material TF can pick from the leaf's
 // bins), the product of each density TF's maximum over the leaf's bins.
 MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& in, int64_t leaf) {
-  uint64_t candidates = c.defaultMaterial != kNoMaterial ? 1ull << c.defaultMaterial : 0;
+  uint64_t candidates = c.additive ? ~0ull : (c.defaultMaterial != kNoMaterial ? 1ull << c.defaultMaterial : 0);
   for (int s = 0; s < c.selectorCount && in.materialMasks; ++s) {
     const int t = c.selectors[s];
     ForEachBin(in.summaries[c.tfs[t].proxy] + leaf * kSummaryWords,
@@ -52,7 +52,7 @@ MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& 
   }
   float majorant = 0.f;
   for (int m = 0; m < c.materialCount; ++m) {
-    if (in.materialMasks && !(candidates & (1ull << m))) continue;
+    if (in.materialMasks && !c.additive && !(candidates & (1ull << m))) continue;
     const MaterialView& mat = c.materials[m];
     float d = mat.base[0];
     for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
@@ -62,7 +62,7 @@ MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& 
                  [&](int bin) { mx = Max(mx, in.binMax[t * kSummaryBins + bin]); });
       d *= mx;
     }
-    majorant = Max(majorant, d);
+    majorant = c.additive ? majorant + d : Max(majorant, d);  // a mixture's extinctions add up
   }
   return majorant;
 }
