@@ -6,6 +6,7 @@
 
 #include "TestSceneHelpers.h"
 #include "cpu_renderer.h"
+#include "scene_json.h"
 
 namespace mmrtm {
 namespace {
@@ -51,6 +52,28 @@ TEST(AdditiveMaterials, MajorantsBoundTheSum) {
     EXPECT_GT(counters.realCollisions, 0u);
     EXPECT_EQ(counters.majorantViolations, 0u) << "kind " << (int)kind;
   }
+}
+
+TEST(AdditiveMaterials, SceneFormatKey) {
+  auto parse = [](const nlohmann::json& extra) {
+    nlohmann::json doc = {{"materials", {{"a", {{"density", 1.0}}}, {"b", {{"density", 2.0}}}}}};
+    doc.merge_patch(extra);
+    SceneInputs inputs;
+    inputs.volumes["scalars"] = test::MakeConstantVolume(4, 1.f);
+    return SceneFromJson(doc, std::move(inputs));
+  };
+  EXPECT_TRUE(parse({{"additive_materials", true}}).additiveMaterials);
+  EXPECT_FALSE(parse({{"default_material", "a"}}).additiveMaterials);
+  try {
+    parse({{"additive_materials", 1}});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("additive_materials: expected true or false"), std::string::npos) << e.what();
+  }
+  // Both materials everywhere: sigma_t = 1 + 2.
+  Scene scene = parse({{"additive_materials", true}});
+  const SceneView view = scene.Build();
+  EXPECT_FLOAT_EQ(view.classifier.Classify(scene.proxies[0].WorldCenter()).sigma_t, 3.f);
 }
 
 }  // namespace

@@ -14,7 +14,7 @@ import unittest
 
 from vtkmodules.vtkCommonCore import vtkFloatArray
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction, vtkPlane, vtkPlaneCollection
-from vtkmodules.vtkImagingCore import vtkImageShiftScale, vtkImageThreshold
+from vtkmodules.vtkImagingCore import vtkImageAppendComponents, vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
 from vtkmodules.vtkFiltersSources import vtkSphereSource
 from vtkmodules.vtkRenderingCore import (vtkActor, vtkTexture, vtkPolyDataMapper, vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
@@ -355,6 +355,43 @@ class MapperTest(unittest.TestCase):
         s.property.SetTransferFunction2D(table(lambda x, g: 0.9 if x >= 1500 and g < 100 else 0.0, (0.1, 0.9, 0.2)))
         s.render()
         self.assertLess(coverage(s.pixels()), coverage(pixels))
+
+    def test_independent_components_mix(self):
+        # Two components: the CT, and the CT shifted down by 1000 (so that its
+        # soft tissue reaches the bone window); each with its own functions.
+        s = Scene()
+        shifted = vtkImageShiftScale()
+        shifted.SetInputConnection(s.reader.GetOutputPort())
+        shifted.SetShift(-1000.0)
+        shifted.SetOutputScalarTypeToShort()
+        both = vtkImageAppendComponents()
+        both.AddInputConnection(s.reader.GetOutputPort())
+        both.AddInputConnection(shifted.GetOutputPort())
+        s.mapper.SetInputConnection(both.GetOutputPort())
+        green = vtkColorTransferFunction()
+        green.AddRGBPoint(0, 0.1, 0.9, 0.2)
+        second = vtkPiecewiseFunction()
+        second.AddPoint(-1000, 0.0)
+        second.AddPoint(1500, 0.0)
+        s.property.SetScalarOpacity(1, second)
+        s.property.SetColor(1, green)
+        s.render()
+        self.assertEqual(s.counts()[0], 1)
+        alone = coverage(s.pixels())
+        self.assertGreater(alone, 0.05, "component 0 alone: the bone")
+        # Component 1 opaque from 0 (the CT's 1000): more of the head shows, in green.
+        second.AddPoint(0, 0.0)
+        second.AddPoint(300, 0.6)
+        s.render()
+        self.assertEqual(s.counts()[1], 2, "editing component 1's function refits")
+        pixels = s.pixels()
+        self.assertGreater(coverage(pixels), alone + 0.02)
+        greenish = sum(1 for i in range(0, len(pixels), 3) if pixels[i + 1] > pixels[i] + 20)
+        self.assertGreater(greenish, 50)
+        # A weight of 0 removes component 1 again.
+        s.property.SetComponentWeight(1, 0.0)
+        s.render()
+        self.assertLess(abs(coverage(s.pixels()) - alone), 0.01)
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()

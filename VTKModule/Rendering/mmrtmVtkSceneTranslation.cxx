@@ -68,16 +68,19 @@ struct MaterialFunctions {
   vtkPiecewiseFunction* gradientOpacity = nullptr;  // null: not used
 };
 
+// `valueProxy` holds the values the functions read (the scalars, or an
+// independent component), over `valueRange`.
 MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, vtkVolumeProperty* property,
-                          int component, const ProxyLayout& proxies, Scene& scene) {
+                          int component, const ProxyLayout& proxies, Scene& scene, int valueProxy = 0,
+                          const std::array<float, 2>* valueRange = nullptr) {
   MaterialDesc m;
   m.name = name;
-  const std::vector<float> x = Positions(proxies.scalarRange);
+  const std::vector<float> x = Positions(valueRange ? *valueRange : proxies.scalarRange);
   const int n = (int)x.size();
 
   // Extinction from opacity per unit distance, over the opacity component
   // (dependent components) or the scalars.
-  const int opacityProxy = proxies.opacity >= 0 ? proxies.opacity : 0;
+  const int opacityProxy = proxies.opacity >= 0 ? proxies.opacity : valueProxy;
   const std::vector<float> xo = proxies.opacity >= 0 ? Positions(proxies.opacityRange) : x;
   const int no = (int)xo.size();
   std::vector<float> alpha(no), density(no);
@@ -126,7 +129,7 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     }
     for (int k = 0; k < 3; ++k) rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
   }
-  m.bindings.push_back({AddCurve(scene, name + " color", 0, x, rgb, 3), Quantity::Albedo});
+  m.bindings.push_back({AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo});
   }
 
   // Shading.
@@ -229,6 +232,25 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
   scene.tfs.clear();
   scene.materials.clear();
   scene.selectors.clear();
+  scene.additiveMaterials = false;
+  if (proxies.independent > 1) {
+    // A material per component, mixed additively; each reads its own proxy.
+    for (int c = 0; c < proxies.independent; ++c) {
+      MaterialFunctions f;
+      f.opacity = property->GetScalarOpacity(c);
+      if (property->GetColorChannels(c) == 3)
+        f.color = property->GetRGBTransferFunction(c);
+      else
+        f.grey = property->GetGrayTransferFunction(c);
+      MaterialDesc m = MakeMaterial("component " + std::to_string(c), f, property, c, proxies, scene, c,
+                                    &proxies.componentRanges[c]);
+      m.base[QuantityOffset(Quantity::Density)] = (float)std::max(property->GetComponentWeight(c), 0.0);
+      scene.materials.push_back(std::move(m));
+    }
+    scene.additiveMaterials = true;
+    scene.defaultMaterial = kNoMaterial;
+    return;
+  }
   MaterialFunctions main;
   main.opacity = property->GetScalarOpacity(component);
   if (property->GetColorChannels(component) == 3)

@@ -11,6 +11,11 @@
 //   scaled to 0-1) and opacity. The RGB albedo is the product of three
 //   3-channel CCTFs, one per component proxy, each scaling one channel: the
 //   merge rule "coefficients from several proxies multiply".
+// - Independent components (IndependentComponents on, 2 to 4 components):
+//   each component is a material over its own proxy with its own functions,
+//   its extinction times the component weight, and the materials are mixed
+//   additively (extinctions add, colours weighted by extinction), as VTK
+//   mixes independent components.
 // - Colour becomes the albedo; gradient opacity g(|grad x|) multiplies
 //   sigma_t through a gradient-magnitude proxy (made only when used).
 // - The functions are sampled at kTableSize points over the scalar range, as
@@ -62,6 +67,11 @@ struct ProxyLayout {
   std::array<float, 2> opacityRange{0.f, 0.f};
   int rgb[3] = {-1, -1, -1};
   float colorScale = 255.f;
+  // IndependentComponents on with several components: proxy c is
+  // component c (c < independent), each with its own functions, mixed
+  // additively (Classifier::additive).
+  int independent = 0;
+  std::array<std::array<float, 2>, 4> componentRanges{};
 };
 
 // Replaces the scene's TFs, materials and selectors with those of the

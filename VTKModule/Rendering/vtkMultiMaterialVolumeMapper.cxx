@@ -62,7 +62,8 @@ struct vtkMultiMaterialVolumeMapper::Internals
   vtkMTimeType EnvironmentTime = 0;
   double EnvironmentScale = 0;
   int MaskTypeBuilt = -1;
-  int DependentBuilt = -1;  // components used as colour + opacity (IndependentComponents off)
+  int DependentBuilt = -1;    // components used as colour + opacity (IndependentComponents off)
+  int IndependentBuilt = -1;  // components mixed additively (IndependentComponents on)
 
   vtkDataObject* Data = nullptr;
   vtkMTimeType MaskTime = 0;
@@ -80,11 +81,11 @@ struct vtkMultiMaterialVolumeMapper::Internals
 
 namespace
 {
-// The latest modification among the property and its component-0 and label
+// The latest modification among the property and its component and label
 // functions (editing a function does not touch the property's own MTime).
 vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
 {
-  vtkMTimeType t = p->GetMTime();
+  vtkMTimeType t = 0;
   if (vtkImageData* table = p->GetTransferFunction2D(0))
     t = std::max(t, table->GetMTime());
   for (int label : p->GetLabelMapLabels())
@@ -96,13 +97,18 @@ vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
     if (vtkColorTransferFunction* f = p->GetLabelColor(label))
       t = std::max(t, f->GetMTime());
   }
-  t = std::max(t, p->GetScalarOpacity(0)->GetMTime());
-  t = std::max(t, p->GetGradientOpacity(0)->GetMTime());
-  if (p->GetColorChannels(0) == 3)
-    t = std::max(t, p->GetRGBTransferFunction(0)->GetMTime());
-  else
-    t = std::max(t, p->GetGrayTransferFunction(0)->GetMTime());
-  return t;
+  for (int c = 0; c < 4; ++c)  // independent components have functions of their own
+  {
+    t = std::max(t, p->GetScalarOpacity(c)->GetMTime());
+    t = std::max(t, p->GetGradientOpacity(c)->GetMTime());
+    if (p->GetColorChannels(c) == 3)
+      t = std::max(t, p->GetRGBTransferFunction(c)->GetMTime());
+    else
+      t = std::max(t, p->GetGrayTransferFunction(c)->GetMTime());
+  }
+  // Last: asking for a component's function the first time creates a
+  // default one and modifies the property.
+  return std::max(t, p->GetMTime());
 }
 
 // Camera, lights, the volume's matrix and the viewport, as values: a change
@@ -343,8 +349,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     const int components = scalars->GetNumberOfComponents();
     const int dependent =
       !property->GetIndependentComponents() && (components == 2 || components == 4) ? components : 0;
+    const int independent =
+      property->GetIndependentComponents() && components > 1 ? std::min(components, 4) : 0;
     // 4 dependent components fill the 4 proxies: no room for a gradient.
-    const bool needGradient = dependent != 4 && mmrtm::NeedsGradientProxy(property, 0, labels);
+    const bool needGradient = dependent != 4 && !independent && mmrtm::NeedsGradientProxy(property, 0, labels);
     vtkMultiMaterialProperty* multi = in.MultiMaterial;
     const vtkMTimeType multiTime = multi ? multi->GetMTime() : 0;
     if (multi && multiTime != in.MultiMaterialTime)
@@ -355,15 +363,20 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     }
     if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
       this->MaskType != in.MaskTypeBuilt || (!multi && needGradient != (in.Layout.gradient >= 0)) ||
-      dependent != in.DependentBuilt)
+      dependent != in.DependentBuilt || independent != in.IndependentBuilt)
     {
       in.HasScene = false;  // until the rebuild succeeds
-      if (!in.Warned && components > 1 && !dependent)
+      if (!in.Warned && components > 4 && independent)
       {
-        vtkWarningMacro("only component 0 of " << components << " independent components is rendered");
+        vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
         in.Warned = true;
       }
-      this->BuildProxies(input, scalars, dependent, needGradient, labels);
+      if (!in.Warned && independent && (mask || mmrtm::NeedsGradientProxy(property, 0, labels)))
+      {
+        vtkWarningMacro("with independent components, masks and gradient opacity are not used");
+        in.Warned = true;
+      }
+      this->BuildProxies(input, scalars, dependent, independent, needGradient, labels);
       in.LightsFromScene = false;
       if (multi)
         this->ParseMultiMaterialScene();
@@ -375,6 +388,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.MaskTime = maskTime;
       in.MaskTypeBuilt = this->MaskType;
       in.DependentBuilt = dependent;
+      in.IndependentBuilt = independent;
       in.PropertyTime = 0;  // translate the property again
       ++in.SceneBuilds;
       restart = true;
@@ -474,10 +488,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 // The proxies of the input (its components as the property uses them), the
 // gradient magnitude when some function reads it, and the mask.
 void vtkMultiMaterialVolumeMapper::BuildProxies(
-  vtkImageData* input, vtkDataArray* scalars, int dependent, bool needGradient, bool labels)
+  vtkImageData* input, vtkDataArray* scalars, int dependent, int independent, bool needGradient, bool labels)
 {
   Internals& in = *this->Internal;
-  vtkImageData* mask = in.Mask;
+  vtkImageData* mask = independent ? nullptr : in.Mask.Get();
   mmrtm::Scene& scene = in.Scene;
   scene.proxies.clear();
   in.ImageIndexToWorld.clear();
@@ -490,6 +504,13 @@ void vtkMultiMaterialVolumeMapper::BuildProxies(
   component(0, dependent == 4 ? "red" : "scalars");
   in.Layout.scalarRange = scene.proxies[0].ValueRange();
   scene.gradientProxy = 0;
+  if (independent)
+  {
+    in.Layout.independent = independent;
+    in.Layout.componentRanges[0] = in.Layout.scalarRange;
+    for (int c = 1; c < independent; ++c)
+      in.Layout.componentRanges[c] = scene.proxies[component(c, "component")].ValueRange();
+  }
   if (dependent == 2)
   {
     in.Layout.opacity = component(1, "opacity");

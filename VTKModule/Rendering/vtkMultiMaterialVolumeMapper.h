@@ -28,7 +28,7 @@
  * Clipping planes (world space) and subvolume cropping (data space) limit
  * what is seen. Not supported yet (a warning is given once): blend modes
  * other than composite, cropping regions other than the subvolume, more
- * than one independent component.
+ * than four independent components.
  *
  * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
  */
@@ -239,7 +239,8 @@ private:
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
   void UpdateEnvironment();
-  void BuildProxies(vtkImageData* input, vtkDataArray* scalars, int dependent, bool needGradient, bool labels);
+  void BuildProxies(
+    vtkImageData* input, vtkDataArray* scalars, int dependent, int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;

@@ -77,7 +77,7 @@ void Scene::Validate() const {
       throw InputError("scene: a material selector must be an MPCTF or MDPTF");
   if (defaultMaterial != kNoMaterial && (defaultMaterial < 0 || defaultMaterial >= (int)materials.size()))
     throw InputError("scene: unknown default material");
-  if (defaultMaterial == kNoMaterial && selectors.empty())
+  if (defaultMaterial == kNoMaterial && selectors.empty() && !additiveMaterials)
     throw InputError("scene: no material classifies any point (set a default material or a material TF)");
   for (const MaterialDesc& m : materials)
     for (float b : m.base)

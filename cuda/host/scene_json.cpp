@@ -123,12 +123,16 @@ class Parser {
   Scene Parse() {
     CheckKeys(doc_, "scene",
               {"volumes", "materials", "material_tfs", "default_material", "gradient_proxy", "lights", "camera",
-               "render", "description", "label_materials", "label_table"});
+               "render", "description", "label_materials", "label_table", "additive_materials"});
     ParseVolumes();
     ExpandLabels();
     ParseMaterialNames();
     for (auto it = Materials().begin(); it != Materials().end(); ++it) ParseMaterial(it.key(), it.value());
     ParseMaterialTFs();
+    if (doc_.contains("additive_materials")) {
+      if (!doc_["additive_materials"].is_boolean()) Fail("additive_materials", "expected true or false");
+      scene_.additiveMaterials = doc_["additive_materials"].get<bool>();
+    }
     if (doc_.contains("default_material")) {
       const json& d = doc_["default_material"];
       if (d.is_null()) {
