@@ -388,6 +388,16 @@ class MapperTest(unittest.TestCase):
         self.assertGreater(coverage(pixels), alone + 0.02)
         greenish = sum(1 for i in range(0, len(pixels), 3) if pixels[i + 1] > pixels[i] + 20)
         self.assertGreater(greenish, 50)
+        # Component 1's gradient opacity (only its edges) is its own: less of it shows.
+        covered = coverage(pixels)
+        edges = vtkPiecewiseFunction()
+        edges.AddPoint(0, 0.0)
+        edges.AddPoint(2000, 1.0)
+        s.property.SetGradientOpacity(1, edges)
+        s.render()
+        self.assertEqual(s.counts()[0], 2, "a component's gradient proxy: a rebuild")
+        self.assertLess(coverage(s.pixels()), covered)
+        s.property.DisableGradientOpacityOn(1)
         # A weight of 0 removes component 1 again.
         s.property.SetComponentWeight(1, 0.0)
         s.render()

@@ -242,7 +242,11 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
         f.color = property->GetRGBTransferFunction(c);
       else
         f.grey = property->GetGrayTransferFunction(c);
-      MaterialDesc m = MakeMaterial("component " + std::to_string(c), f, property, c, proxies, scene, c,
+      ProxyLayout own = proxies;  // this component's gradient proxy, if any
+      own.gradient = proxies.componentGradient[c];
+      own.gradientRange = proxies.componentGradientRanges[c];
+      if (own.gradient >= 0 && UsesGradientOpacity(property, c)) f.gradientOpacity = property->GetGradientOpacity(c);
+      MaterialDesc m = MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c,
                                     &proxies.componentRanges[c]);
       m.base[QuantityOffset(Quantity::Density)] = (float)std::max(property->GetComponentWeight(c), 0.0);
       scene.materials.push_back(std::move(m));

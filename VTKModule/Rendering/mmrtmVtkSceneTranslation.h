@@ -72,6 +72,10 @@ struct ProxyLayout {
   // additively (Classifier::additive).
   int independent = 0;
   std::array<std::array<float, 2>, 4> componentRanges{};
+  // The gradient magnitude of an independent component whose gradient
+  // opacity is used (-1: none), while there is room among the 4 proxies.
+  std::array<int, 4> componentGradient{-1, -1, -1, -1};
+  std::array<std::array<float, 2>, 4> componentGradientRanges{};
 };
 
 // Replaces the scene's TFs, materials and selectors with those of the

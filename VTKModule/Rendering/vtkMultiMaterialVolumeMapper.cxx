@@ -64,6 +64,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   int MaskTypeBuilt = -1;
   int DependentBuilt = -1;    // components used as colour + opacity (IndependentComponents off)
   int IndependentBuilt = -1;  // components mixed additively (IndependentComponents on)
+  int ComponentGradientsBuilt = -1;
 
   vtkDataObject* Data = nullptr;
   vtkMTimeType MaskTime = 0;
@@ -353,6 +354,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       property->GetIndependentComponents() && components > 1 ? std::min(components, 4) : 0;
     // 4 dependent components fill the 4 proxies: no room for a gradient.
     const bool needGradient = dependent != 4 && !independent && mmrtm::NeedsGradientProxy(property, 0, labels);
+    // Independent components: which of them use gradient opacity (bit c).
+    int componentGradients = 0;
+    for (int c = 0; c < independent; ++c)
+      componentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
     vtkMultiMaterialProperty* multi = in.MultiMaterial;
     const vtkMTimeType multiTime = multi ? multi->GetMTime() : 0;
     if (multi && multiTime != in.MultiMaterialTime)
@@ -363,7 +368,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     }
     if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
       this->MaskType != in.MaskTypeBuilt || (!multi && needGradient != (in.Layout.gradient >= 0)) ||
-      dependent != in.DependentBuilt || independent != in.IndependentBuilt)
+      dependent != in.DependentBuilt || independent != in.IndependentBuilt ||
+      componentGradients != in.ComponentGradientsBuilt)
     {
       in.HasScene = false;  // until the rebuild succeeds
       if (!in.Warned && components > 4 && independent)
@@ -371,12 +377,12 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
         in.Warned = true;
       }
-      if (!in.Warned && independent && (mask || mmrtm::NeedsGradientProxy(property, 0, labels)))
+      if (!in.Warned && independent && mask)
       {
-        vtkWarningMacro("with independent components, masks and gradient opacity are not used");
+        vtkWarningMacro("with independent components, the mask is not used");
         in.Warned = true;
       }
-      this->BuildProxies(input, scalars, dependent, independent, needGradient, labels);
+      this->BuildProxies(property, input, scalars, dependent, independent, needGradient, labels);
       in.LightsFromScene = false;
       if (multi)
         this->ParseMultiMaterialScene();
@@ -389,6 +395,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.MaskTypeBuilt = this->MaskType;
       in.DependentBuilt = dependent;
       in.IndependentBuilt = independent;
+      in.ComponentGradientsBuilt = componentGradients;
       in.PropertyTime = 0;  // translate the property again
       ++in.SceneBuilds;
       restart = true;
@@ -487,8 +494,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
 // The proxies of the input (its components as the property uses them), the
 // gradient magnitude when some function reads it, and the mask.
-void vtkMultiMaterialVolumeMapper::BuildProxies(
-  vtkImageData* input, vtkDataArray* scalars, int dependent, int independent, bool needGradient, bool labels)
+void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtkImageData* input,
+  vtkDataArray* scalars, int dependent, int independent, bool needGradient, bool labels)
 {
   Internals& in = *this->Internal;
   vtkImageData* mask = independent ? nullptr : in.Mask.Get();
@@ -510,6 +517,21 @@ void vtkMultiMaterialVolumeMapper::BuildProxies(
     in.Layout.componentRanges[0] = in.Layout.scalarRange;
     for (int c = 1; c < independent; ++c)
       in.Layout.componentRanges[c] = scene.proxies[component(c, "component")].ValueRange();
+    // Gradient magnitudes of the components with gradient opacity, while
+    // there is room among the proxies.
+    for (int c = 0; c < independent; ++c)
+    {
+      if (!mmrtm::UsesGradientOpacity(property, c))
+        continue;
+      if (scene.proxies.size() >= static_cast<size_t>(mmrtm::kMaxProxies))
+      {
+        vtkWarningMacro("no room for the gradient of component " << c << ": its gradient opacity is not used");
+        continue;
+      }
+      in.Layout.componentGradient[c] = static_cast<int>(scene.proxies.size());
+      scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[c], "gradient"));
+      in.Layout.componentGradientRanges[c] = scene.proxies.back().ValueRange();
+    }
   }
   if (dependent == 2)
   {

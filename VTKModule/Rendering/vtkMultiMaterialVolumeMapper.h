@@ -28,7 +28,8 @@
  * Clipping planes (world space) and subvolume cropping (data space) limit
  * what is seen. Not supported yet (a warning is given once): blend modes
  * other than composite, cropping regions other than the subvolume, more
- * than four independent components.
+ * than four independent components, gradient opacity of independent
+ * components beyond the four proxies.
  *
  * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
  */
@@ -43,6 +44,7 @@
 
 class vtkDataArray;
 class vtkImageData;
+class vtkVolumeProperty;
 class vtkMultiMaterialProperty;
 class vtkTexture;
 namespace mmrtm
@@ -239,8 +241,8 @@ private:
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
   void UpdateEnvironment();
-  void BuildProxies(
-    vtkImageData* input, vtkDataArray* scalars, int dependent, int independent, bool needGradient, bool labels);
+  void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
+    int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;
