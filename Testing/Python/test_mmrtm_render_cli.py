@@ -152,6 +152,15 @@ class RenderCli(unittest.TestCase):
             self.expect_failure(r, "--backend cuda: ")
         self.expect_failure(self.run_render(HEADSQ, "--backend", "gpu"), "--backend expects auto, cpu or cuda", code=2)
 
+    def test_degenerate_volumes(self):
+        # One voxel, a 1 x 1 x 1000 line, a single slice: nothing to render,
+        # said clearly instead of an empty image (or a camera error).
+        header = "NRRD0004\ntype: float\ndimension: 3\nsizes: %d %d %d\nencoding: raw\nendian: little\n\n"
+        for name, sizes in [("one.nrrd", (1, 1, 1)), ("line.nrrd", (1, 1, 1000)), ("slice.nrrd", (50, 50, 1))]:
+            count = sizes[0] * sizes[1] * sizes[2]
+            path = self.write(name, header.encode() % sizes + struct.pack("<%df" % count, *([1000.0] * count)), "wb")
+            self.expect_failure(self.run_render(path), name, "at least 2 voxels along every axis")
+
     def test_missing_input(self):
         self.expect_failure(self.run_render(os.path.join(self.dir, "nope.nrrd")), "nope.nrrd")
 

@@ -34,6 +34,15 @@ int Scene::MaterialIndex(const std::string& name) const {
 
 void Scene::Validate() const {
   if (proxies.empty()) throw InputError("scene: no volume");
+  // The tracked region lies between the first and last voxel centres (as
+  // VTK's image bounds): one voxel along an axis leaves nothing to render,
+  // which is better said than shown as an empty image.
+  for (int a = 0; a < 3; ++a)
+    if (proxies[0].dims[a] < 2)
+      throw InputError(proxies[0].source + ": " + std::to_string(proxies[0].dims[0]) + " x " +
+                       std::to_string(proxies[0].dims[1]) + " x " + std::to_string(proxies[0].dims[2]) +
+                       " voxels: volume rendering needs at least 2 voxels along every axis (the volume spans "
+                       "from the first to the last voxel centre, so a single slice has no thickness)");
   if ((int)proxies.size() > kMaxProxies)
     throw InputError("scene: " + std::to_string(proxies.size()) + " proxy volumes; at most " +
                      std::to_string(kMaxProxies) + " are supported");
