@@ -62,12 +62,6 @@ std::string ReadDicomTransferSyntax(const std::string& file) {
   return "";
 }
 
-// The syntaxes vtkDICOMImageReader can decode: implicit/explicit little
-// endian and explicit big endian, all uncompressed.
-bool IsUncompressedTransferSyntax(const std::string& uid) {
-  return uid == "1.2.840.10008.1.2" || uid == "1.2.840.10008.1.2.1" || uid == "1.2.840.10008.1.2.2";
-}
-
 std::string DescribeTransferSyntax(const std::string& uid) {
   if (uid == "1.2.840.10008.1.2.4.90" || uid == "1.2.840.10008.1.2.4.91") return "JPEG 2000 compressed";
   if (uid.rfind("1.2.840.10008.1.2.4.20", 0) == 0) return "High-Throughput JPEG 2000 compressed";

@@ -233,19 +233,15 @@ double MedianGap(const std::vector<double>& d) {
   return gaps[gaps.size() / 2];
 }
 
-// The uncompressed transfer syntaxes (implicit/explicit little endian,
-// explicit big endian): their pixel data has a known size.
-bool IsUncompressed(const std::string& uid) {
-  return uid.empty() || uid == "1.2.840.10008.1.2" || uid == "1.2.840.10008.1.2.1" || uid == "1.2.840.10008.1.2.2";
-}
-
 // Decodes one slice (rescaled to modality units) into `dst` (rows x columns floats).
 void ReadSlicePixels(const std::string& folder, const SliceHeader& s, float* dst) {
   // GDCM pads a cut-short uncompressed file with zeros without a word; a file
   // too small for its pixels is damaged.
   std::error_code ec;
   const double pixelBytes = (double)s.rows * s.columns * ((s.bitsAllocated + 7) / 8);
-  if (IsUncompressed(s.transferSyntax) && (double)fs::file_size(s.file, ec) < pixelBytes)
+  // (No transfer syntax: an old file without a meta header, uncompressed.)
+  const bool uncompressed = s.transferSyntax.empty() || IsUncompressedTransferSyntax(s.transferSyntax);
+  if (uncompressed && (double)fs::file_size(s.file, ec) < pixelBytes)
     throw InputError(folder + ": " + FileName(s.file) + " is " + std::to_string(fs::file_size(s.file, ec)) +
                      " bytes, too short for its " + std::to_string((long long)pixelBytes) +
                      " bytes of pixel data (truncated?)");

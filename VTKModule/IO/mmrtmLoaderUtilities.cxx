@@ -159,6 +159,10 @@ void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock) {
                        v.voxels.begin() + b + hi * run);
 }
 
+bool IsUncompressedTransferSyntax(const std::string& uid) {
+  return uid == "1.2.840.10008.1.2" || uid == "1.2.840.10008.1.2.1" || uid == "1.2.840.10008.1.2.2";
+}
+
 // ---------------------------------------------------------------------------
 // Memory and warnings
 // ---------------------------------------------------------------------------

@@ -39,6 +39,10 @@ double Dot(const Vec3d& a, const Vec3d& b);
 
 [[noreturn]] void ThrowComponents(const std::string& path, int64_t components);
 
+// The uncompressed DICOM transfer syntaxes (implicit/explicit little endian,
+// explicit big endian): pixel data of a known size, which every reader decodes.
+bool IsUncompressedTransferSyntax(const std::string& uid);
+
 // ---------------------------------------------------------------------------
 // Voxel conversion (mmrtmLoaderUtilities.cxx)
 // ---------------------------------------------------------------------------

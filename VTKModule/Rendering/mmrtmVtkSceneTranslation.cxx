@@ -10,9 +10,9 @@
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
 #include <vtkLight.h>
-#include <vtkPointData.h>
 #include <vtkLightCollection.h>
 #include <vtkPiecewiseFunction.h>
+#include <vtkPointData.h>
 #include <vtkRenderer.h>
 #include <vtkVolumeProperty.h>
 
@@ -38,6 +38,23 @@ int AddCurve(Scene& scene, const std::string& where, int proxy, const std::vecto
   tf.values = values;
   scene.tfs.push_back(std::move(tf));
   return (int)scene.tfs.size() - 1;
+}
+
+// VTK's opacity per unit distance as extinction: a slab `unit` thick
+// transmits 1 - alpha.
+float Extinction(double alpha, double unit) { return (float)(-std::log(1.0 - std::clamp(alpha, 0.0, 0.9999)) / unit); }
+
+double UnitDistance(vtkVolumeProperty* property, int component) {
+  return std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
+}
+
+// Shade, Specular and SpecularPower on a material (the rule in the header).
+void ApplyShading(vtkVolumeProperty* property, int component, MaterialDesc& m) {
+  const bool shade = property->GetShade(component) != 0;
+  m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
+  const double specular = property->GetSpecular(component), power = std::max(property->GetSpecularPower(component), 0.0);
+  m.base[QuantityOffset(Quantity::Roughness)] =
+      specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
 }
 
 bool IsConstantOne(vtkPiecewiseFunction* f) {
@@ -68,6 +85,18 @@ struct MaterialFunctions {
   vtkPiecewiseFunction* gradientOpacity = nullptr;  // null: not used
 };
 
+// Component c's own functions (its gradient opacity when it is used).
+MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c) {
+  MaterialFunctions f;
+  f.opacity = property->GetScalarOpacity(c);
+  if (property->GetColorChannels(c) == 3)
+    f.color = property->GetRGBTransferFunction(c);
+  else
+    f.grey = property->GetGrayTransferFunction(c);
+  if (UsesGradientOpacity(property, c)) f.gradientOpacity = property->GetGradientOpacity(c);
+  return f;
+}
+
 // `valueProxy` holds the values the functions read (the scalars, or an
 // independent component), over `valueRange`.
 MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, vtkVolumeProperty* property,
@@ -88,9 +117,7 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     f.opacity->GetTable(xo.front(), xo.back(), no, alpha.data());
   else
     alpha[0] = (float)f.opacity->GetValue(xo[0]);
-  const double unit = std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
-  for (int i = 0; i < no; ++i)
-    density[i] = (float)(-std::log(1.0 - std::clamp((double)alpha[i], 0.0, 0.9999)) / unit);
+  for (int i = 0; i < no; ++i) density[i] = Extinction(alpha[i], UnitDistance(property, component));
   m.base[QuantityOffset(Quantity::Density)] = 1.f;
   m.bindings.push_back({AddCurve(scene, name + " scalar opacity", opacityProxy, xo, density, 1), Quantity::Density});
 
@@ -118,28 +145,20 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
                             Quantity::Albedo});
     }
   } else {
-  // Albedo from colour.
-  std::vector<float> rgb(3 * n);
-  for (int i = 0; i < n; ++i) {
-    double c[3];
-    if (f.color) {
-      f.color->GetColor(x[i], c);
-    } else {
-      c[0] = c[1] = c[2] = f.grey->GetValue(x[i]);
+    // Albedo from colour.
+    std::vector<float> rgb(3 * n);
+    for (int i = 0; i < n; ++i) {
+      double c[3];
+      if (f.color) {
+        f.color->GetColor(x[i], c);
+      } else {
+        c[0] = c[1] = c[2] = f.grey->GetValue(x[i]);
+      }
+      for (int k = 0; k < 3; ++k) rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
     }
-    for (int k = 0; k < 3; ++k) rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
+    m.bindings.push_back({AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo});
   }
-  m.bindings.push_back({AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo});
-  }
-
-  // Shading.
-  const bool shade = property->GetShade(component) != 0;
-  m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
-  const double specular = property->GetSpecular(component), power = std::max(property->GetSpecularPower(component), 0.0);
-  m.base[QuantityOffset(Quantity::Roughness)] =
-      specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
-  m.base[QuantityOffset(Quantity::Metallic)] = 0.f;
-  m.base[QuantityOffset(Quantity::Anisotropy)] = 0.f;
+  ApplyShading(property, component, m);
   return m;
 }
 
@@ -183,7 +202,6 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
   vtkDataArray* rgba = table->GetPointData()->GetScalars();
   const int nx = dims[0], ny = dims[1];
   const int bands = std::min(nx, kMax2DBands);
-  const double unit = std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
   std::vector<float> g(ny);
   for (int j = 0; j < ny; ++j) g[j] = (float)(origin[1] + j * spacing[1]);
   if (ny == 1) g.push_back(g[0] + 1.f);  // a constant in the gradient: two equal points
@@ -200,7 +218,7 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
       double sum[4] = {0, 0, 0, 0};
       for (int i = i0; i < i1; ++i)
         for (int c = 0; c < 4; ++c) sum[c] += rgba->GetComponent(i + (vtkIdType)nx * row, c) / (i1 - i0);
-      density.push_back((float)(-std::log(1.0 - std::clamp(sum[3], 0.0, 0.9999)) / unit));
+      density.push_back(Extinction(sum[3], UnitDistance(property, component)));
       for (int c = 0; c < 3; ++c) albedo.push_back((float)std::clamp(sum[c], 0.0, 1.0));
     }
     // The band covers its columns' cells: from half a column below the
@@ -212,11 +230,7 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
     m.base[QuantityOffset(Quantity::Density)] = 1.f;
     m.bindings.push_back({AddCurve(scene, m.name + " opacity", proxies.gradient, g, density, 1), Quantity::Density});
     m.bindings.push_back({AddCurve(scene, m.name + " color", proxies.gradient, g, albedo, 3), Quantity::Albedo});
-    const bool shade = property->GetShade(component) != 0;
-    m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
-    const double specular = property->GetSpecular(component), power = std::max(property->GetSpecularPower(component), 0.0);
-    m.base[QuantityOffset(Quantity::Roughness)] =
-        specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
+    ApplyShading(property, component, m);
     selector.keys.push_back((float)lo);
     selector.keys.push_back((float)hi);
     selector.materials.push_back((int)scene.materials.size());
@@ -236,16 +250,10 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
   if (proxies.independent > 1) {
     // A material per component, mixed additively; each reads its own proxy.
     for (int c = 0; c < proxies.independent; ++c) {
-      MaterialFunctions f;
-      f.opacity = property->GetScalarOpacity(c);
-      if (property->GetColorChannels(c) == 3)
-        f.color = property->GetRGBTransferFunction(c);
-      else
-        f.grey = property->GetGrayTransferFunction(c);
-      ProxyLayout own = proxies;  // this component's gradient proxy, if any
+      MaterialFunctions f = ComponentFunctions(property, c);
+      ProxyLayout own = proxies;  // this component's gradient proxy, if there was room for one
       own.gradient = proxies.componentGradient[c];
       own.gradientRange = proxies.componentGradientRanges[c];
-      if (own.gradient >= 0 && UsesGradientOpacity(property, c)) f.gradientOpacity = property->GetGradientOpacity(c);
       MaterialDesc m = MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c,
                                     &proxies.componentRanges[c]);
       m.base[QuantityOffset(Quantity::Density)] = (float)std::max(property->GetComponentWeight(c), 0.0);
@@ -255,13 +263,7 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
     scene.defaultMaterial = kNoMaterial;
     return;
   }
-  MaterialFunctions main;
-  main.opacity = property->GetScalarOpacity(component);
-  if (property->GetColorChannels(component) == 3)
-    main.color = property->GetRGBTransferFunction(component);
-  else
-    main.grey = property->GetGrayTransferFunction(component);
-  if (UsesGradientOpacity(property, component)) main.gradientOpacity = property->GetGradientOpacity(component);
+  const MaterialFunctions main = ComponentFunctions(property, component);
   if (vtkImageData* table = TransferFunction2D(property, component); table && proxies.gradient >= 0) {
     Add2DMaterials(table, property, component, proxies, scene);  // no default: outside the bands is empty
     scene.defaultMaterial = kNoMaterial;

@@ -23,7 +23,7 @@
 //   sharpness and log scales.
 // - Shade off: volume scattering only (isotropic phase). Shade on: surface
 //   scattering with probability kShadedSurfaceProbability on the gradient
-//   normal; roughness sqrt(2 / (SpecularPower + 2)) (the Blinn-Phong
+//   normal; roughness (2 / (SpecularPower + 2))^(1/4) (the Blinn-Phong
 //   exponent's GGX equivalent), 1 when Specular is 0. Ambient is a constant
 //   environment light of that radiance. Diffuse is not used: the albedo is
 //   the colour.

@@ -49,6 +49,9 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::unique_ptr<mmrtm::Film> Film;
   std::string BackendDescription;
   vtkNew<vtkMatrix4x4> Matrix;  // the volume's matrix at the last render
+  // Draws the image as a texture: the OpenGL helper, from the object factory
+  // at the first draw (RenderingVolumeOpenGL2 must be loaded by then).
+  vtkSmartPointer<vtkRayCastImageDisplayHelper> DisplayHelper;
 
   // Index-to-world of each proxy before the volume's matrix.
   std::vector<mmrtm::Affine3> ImageIndexToWorld;
@@ -740,16 +743,26 @@ void vtkMultiMaterialVolumeMapper::Draw(vtkRenderer* ren, vtkVolume* vol, const 
   // everything: the camera rays already stopped at the opaque geometry, so
   // where it is in front the image is transparent.
   const float depth = 1e-6f;
-  vtkNew<vtkRayCastImageDisplayHelper> helper;  // the OpenGL one, through the object factory
-  helper->PreMultipliedColorsOn();
+  vtkSmartPointer<vtkRayCastImageDisplayHelper>& helper = this->Internal->DisplayHelper;
+  if (!helper)
+  {
+    helper = vtkSmartPointer<vtkRayCastImageDisplayHelper>::Take(vtkRayCastImageDisplayHelper::New());
+    if (!helper)
+    {
+      vtkErrorMacro("no OpenGL image display helper: load VTK::RenderingVolumeOpenGL2");
+      return;
+    }
+    helper->PreMultipliedColorsOn();
+  }
   int size[2] = { width, height }, origin[2] = { 0, 0 };
   helper->RenderTexture(vol, ren, size, size, size, origin, depth, rgba.data());
-  helper->ReleaseGraphicsResources(ren->GetRenderWindow());
 }
 
-void vtkMultiMaterialVolumeMapper::ReleaseGraphicsResources(vtkWindow*)
+void vtkMultiMaterialVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 {
-  // Textures are made and released within each Render.
+  // The display helper's texture and shader (the tracer holds no graphics).
+  if (this->Internal->DisplayHelper)
+    this->Internal->DisplayHelper->ReleaseGraphicsResources(window);
 }
 
 void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)

@@ -13,12 +13,10 @@ namespace mmrtm {
 
 namespace {
 
-std::string Where(const HostVolume& v) { return v.source.empty() ? v.name : v.source; }
-
 HostVolume EmptyLike(const HostVolume& source, const std::string& name, const std::string& what) {
   HostVolume out;
   out.name = name;
-  out.source = what + " of " + Where(source);
+  out.source = what + " of " + source.Where();
   out.interpolation = Interpolation::Trilinear;  // all derived proxies are continuous
   out.dims = source.dims;
   out.indexToWorld = source.indexToWorld;

@@ -28,6 +28,8 @@ struct HostVolume {
   std::vector<uint8_t> voxels;  // dims[0]*dims[1]*dims[2] values of `type`, x fastest
   Affine3 indexToWorld;         // voxel index -> world (millimetres, LPS for medical data)
 
+  // How messages name the volume: its source, else its proxy name.
+  const std::string& Where() const { return source.empty() ? name : source; }
   int64_t VoxelCount() const { return (int64_t)dims[0] * dims[1] * dims[2]; }
   VolumeView View() const;                      // throws if the geometry is singular
   float Value(int64_t i) const;                 // voxel i converted to float

@@ -10,8 +10,6 @@ namespace mmrtm {
 
 namespace {
 
-std::string Where(const HostVolume& v) { return v.source.empty() ? v.name : v.source; }
-
 // World box of a volume's domain: its voxels, half a voxel beyond the
 // first and last centres (where nearest lookup still finds a voxel).
 std::array<Vec3, 2> DomainBox(const HostVolume& v) {
@@ -59,8 +57,8 @@ HostVolume AlignLabelsToVolume(HostVolume labels, const HostVolume& reference, b
   const auto lb = DomainBox(labels), rb = DomainBox(reference);
   for (int a = 0; a < 3; ++a)
     if (lb[1][a] <= rb[0][a] || rb[1][a] <= lb[0][a])
-      throw InputError(Where(labels) + ": the label map (" + BoxText(lb) + ") does not overlap the volume " +
-                       Where(reference) + " (" + BoxText(rb) + ")");
+      throw InputError(labels.Where() + ": the label map (" + BoxText(lb) + ") does not overlap the volume " +
+                       reference.Where() + " (" + BoxText(rb) + ")");
 
   HostVolume out;
   out.name = labels.name;
@@ -99,8 +97,8 @@ HostVolume AlignLabelsToVolume(HostVolume labels, const HostVolume& reference, b
   bool any = false;
   for (int64_t i = 0, n = out.VoxelCount(); i < n && !any; ++i) any = out.Value(i) != 0.f;
   if (!any)
-    throw InputError(Where(labels) + ": no label is left after resampling the label map onto the grid of " +
-                     Where(reference) + " (label box " + BoxText(lb) + ", volume box " + BoxText(rb) + ")");
+    throw InputError(labels.Where() + ": no label is left after resampling the label map onto the grid of " +
+                     reference.Where() + " (label box " + BoxText(lb) + ", volume box " + BoxText(rb) + ")");
   if (resampled) *resampled = true;
   return out;
 }

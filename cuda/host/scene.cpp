@@ -39,7 +39,7 @@ void Scene::Validate() const {
   // which is better said than shown as an empty image.
   for (int a = 0; a < 3; ++a)
     if (proxies[0].dims[a] < 2)
-      throw InputError(proxies[0].source + ": " + std::to_string(proxies[0].dims[0]) + " x " +
+      throw InputError(proxies[0].Where() + ": " + std::to_string(proxies[0].dims[0]) + " x " +
                        std::to_string(proxies[0].dims[1]) + " x " + std::to_string(proxies[0].dims[2]) +
                        " voxels: volume rendering needs at least 2 voxels along every axis (the volume spans "
                        "from the first to the last voxel centre, so a single slice has no thickness)");

@@ -42,17 +42,19 @@ struct RefitInputs {
 
 // The extinction bound of leaf `leaf`: over the materials that can occur in
 // it (the default, and whatever a material TF can pick from the leaf's
-// bins), the product of each density TF's maximum over the leaf's bins.
+// bins), the product of each density TF's maximum over the leaf's bins;
+// their maximum, or their sum for an additive mixture.
 MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& in, int64_t leaf) {
+  // (A mixture has every material everywhere.)
   uint64_t candidates = c.additive ? ~0ull : (c.defaultMaterial != kNoMaterial ? 1ull << c.defaultMaterial : 0);
-  for (int s = 0; s < c.selectorCount && in.materialMasks; ++s) {
+  for (int s = 0; s < c.selectorCount && in.materialMasks && !c.additive; ++s) {
     const int t = c.selectors[s];
     ForEachBin(in.summaries[c.tfs[t].proxy] + leaf * kSummaryWords,
                [&](int b) { candidates |= in.binMaterials[t * kSummaryBins + b]; });
   }
   float majorant = 0.f;
   for (int m = 0; m < c.materialCount; ++m) {
-    if (in.materialMasks && !c.additive && !(candidates & (1ull << m))) continue;
+    if (in.materialMasks && !(candidates & (1ull << m))) continue;
     const MaterialView& mat = c.materials[m];
     float d = mat.base[0];
     for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
