@@ -61,18 +61,21 @@ options:
                         grid), octree-voxelmax (the paper's voxel-value refit; not
                         conservative, for comparison only)
   --leaf-level L        octree leaf level, -1 chooses from the volume size (default: -1)
+  --ray-march-step MM   step of --estimator raymarch, mm (default: 0.5)
   --shadow-scale A      shadow-ray extinction scale in (0, 1] (default: 0.8; 1 is unbiased)
   --max-bounces N       bounce limit (default: 32)
   --exposure X          exposure multiplier before tone mapping (default: 1)
   --output FILE.png     tone-mapped image (default: mmrtm-render.png)
   --output-linear FILE.pfm   linear radiance, float RGB
+  --output-variance FILE.pfm  per-pixel variance of that mean (from the samples), float RGB
   --stats-json FILE     timings, samples, collisions, density lookups and noise
   --quiet               no progress bar
   --help                this text
 )";
 
 struct Options {
-  std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear, statsJson;
+  std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear,
+      outputVariance, statsJson;
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
   bool quiet = false, listSeries = false;
@@ -148,6 +151,8 @@ Options ParseArguments(int argc, char** argv) {
     } else if (a == "--leaf-level") o.render["leaf_level"] = ParseInteger(a, value(), -1, 11);
     else if (a == "--output") o.output = value();
     else if (a == "--output-linear") o.outputLinear = value();
+    else if (a == "--output-variance") o.outputVariance = value();
+    else if (a == "--ray-march-step") o.render["ray_march_step"] = ParseReal(a, value());
     else if (a == "--stats-json") o.statsJson = value();
     else if (a == "--quiet") o.quiet = true;
     else if (a.size() > 1 && a[0] == '-') UsageError("unknown option " + a);
@@ -214,6 +219,7 @@ int Run(const Options& o) {
   mmrtm::RequireBackend(o.backend);
   CheckWritable(o.output);
   CheckWritable(o.outputLinear);
+  CheckWritable(o.outputVariance);
   CheckWritable(o.statsJson);
 
   // The scene document: preset, then the scene file over it, then the options.
@@ -278,6 +284,7 @@ int Run(const Options& o) {
 
   mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, film.ToneMapped(rs.exposure, rs.toneMapper));
   if (!o.outputLinear.empty()) mmrtm::WritePFM(o.outputLinear, film.Linear());
+  if (!o.outputVariance.empty()) mmrtm::WritePFM(o.outputVariance, film.VarianceOfMeanImage());
 
   const mmrtm::NoiseEstimate noise = film.Noise();
   const double samples = (double)film.Width() * film.Height() * film.Samples();

@@ -49,6 +49,13 @@ RGBImage Film::Linear() const {
   return image;
 }
 
+RGBImage Film::VarianceOfMeanImage() const {
+  RGBImage image{width_, height_, std::vector<RGB>((size_t)width_ * height_)};
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) image.pixels[(size_t)y * width_ + x] = VarianceOfMean(x, y);
+  return image;
+}
+
 std::vector<uint8_t> Film::ToneMapped(float exposure, ToneMapper op, int channels) const {
   std::vector<uint8_t> out((size_t)width_ * height_ * channels);
   for (int y = 0; y < height_; ++y)

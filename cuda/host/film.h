@@ -43,6 +43,8 @@ class Film {
   NoiseEstimate Noise() const;
 
   RGBImage Linear() const;
+  // VarianceOfMean of every pixel, laid out as Linear().
+  RGBImage VarianceOfMeanImage() const;
   // 8-bit sRGB, row 0 at the top; 4 channels adds alpha (premultiplied colour).
   std::vector<uint8_t> ToneMapped(float exposure, ToneMapper op, int channels = 3) const;
 

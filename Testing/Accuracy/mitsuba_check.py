@@ -1,0 +1,255 @@
+#!/usr/bin/env python3
+"""An independent check of the tracer: Mitsuba 3 renders the same purely
+volumetric scene, and the two images must agree within their noise.
+
+    Testing/Accuracy/mitsuba_check.py             # 256 x 256, the report's figures
+    Testing/Accuracy/mitsuba_check.py --ci        # 48 x 48, a pass/fail test (CTest)
+
+The scene: the head CT ct_head_headsq.nrrd (64 x 64 x 93 voxels) through a
+density CCTF and an albedo CCTF, evaluated here at the voxels into two grids,
+an extinction grid (sigma_t / sigma_max) and an albedo-parameter grid (the
+albedo is a linear function of it). Both renderers read exactly these grids
+and interpolate them trilinearly between voxel centres, so the medium is the
+same point for point:
+  - mmrtm-render reads them as two proxies through identity TFs (a CCTF from
+    0 to 1 on the extinction, a linear colour ramp on the albedo parameter);
+  - Mitsuba reads them as `gridvolume`s of a `heterogeneous` medium inside a
+    `cube` with a `null` BSDF that spans the same box between the first and
+    last voxel centres.
+Henyey-Greenstein phase (g = 0.3), no surface scattering, a constant
+environment and a directional light, a pinhole camera, a box pixel filter,
+64 bounces in both and unbiased shadow rays (shadow scale 1).
+
+Agreement is measured on 8 x 8-pixel blocks: z = (block mean A - block mean B)
+/ sqrt(var A + var B), with each block's variance summed from per-pixel
+variances (ours from its samples, Mitsuba's across independent batches). For
+two unbiased estimates of the same image the mean z^2 over blocks and
+channels is 1 with a standard deviation of sqrt(2 / K) for K terms; the check
+fails above 1 + 5 sqrt(2 / K) (a one-in-a-million tail for a chi-square),
+which a relative bias of a fraction of the noise already exceeds.
+
+Speed: the time each renderer needs to reach the same relative noise, from
+time x noise^2 (both are unbiased, so the error is the noise).
+"""
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import mmrtm_accuracy as acc  # noqa: E402
+
+SKIP = 77  # CTest's SKIP_RETURN_CODE
+
+# The medium, as TFs over the CT values of ct_head_headsq.nrrd (0 .. ~3300).
+DENSITY_POINTS = [(600.0, 0.0), (1000.0, 0.25), (1400.0, 1.0)]  # x, density in 0..1
+SIGMA_MAX = 0.35  # extinction per mm where the density TF gives 1
+ALBEDO_RANGE = (900.0, 1600.0)  # albedo parameter 0..1 over these CT values
+ALBEDO_LOW, ALBEDO_HIGH = (0.85, 0.45, 0.35), (0.97, 0.95, 0.9)
+G = 0.3
+ENVIRONMENT = (0.35, 0.4, 0.5)
+SUN_DIRECTION = (0.45, 0.6, -0.66)  # direction of travel, world (LPS)
+SUN_IRRADIANCE = (2.0, 1.9, 1.7)
+MAX_BOUNCES = 64
+
+
+def read_nrrd(path):
+    """The few NRRD fields ct_head_headsq.nrrd uses: type short, gzip, spacings."""
+    import gzip
+    with open(path, "rb") as f:
+        raw = f.read()
+    header, _, body = raw.partition(b"\n\n")
+    fields = {}
+    for line in header.decode().splitlines()[1:]:
+        if ":" in line and not line.startswith("#"):
+            key, value = line.split(":", 1)
+            fields[key.strip()] = value.strip()
+    if fields.get("type") != "short" or fields.get("encoding") != "gzip":
+        raise SystemExit(f"{path}: expected a gzip-encoded short NRRD")
+    sizes = [int(v) for v in fields["sizes"].split()]
+    spacing = [float(v) for v in fields["spacings"].split()]
+    data = np.frombuffer(gzip.decompress(body), dtype="<i2").reshape(sizes[::-1])  # (z, y, x)
+    return data.astype(np.float64), spacing
+
+
+def write_nrrd(path, grid, spacing):
+    """A float NRRD with LPS geometry, origin 0, axis-aligned."""
+    nz, ny, nx = grid.shape
+    header = ("NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\n"
+              f"sizes: {nx} {ny} {nz}\n"
+              f"space directions: ({spacing[0]},0,0) (0,{spacing[1]},0) (0,0,{spacing[2]})\n"
+              "space origin: (0,0,0)\nendian: little\nencoding: raw\n\n")
+    with open(path, "wb") as f:
+        f.write(header.encode())
+        f.write(np.ascontiguousarray(grid, dtype="<f4").tobytes())
+
+
+def make_grids():
+    values, spacing = read_nrrd(acc.DATA / "ct_head_headsq.nrrd")
+    xs, ys = zip(*DENSITY_POINTS)
+    density = np.interp(values, xs, ys)
+    albedo_t = np.clip((values - ALBEDO_RANGE[0]) / (ALBEDO_RANGE[1] - ALBEDO_RANGE[0]), 0.0, 1.0)
+    return density, albedo_t, spacing
+
+
+def camera(density, spacing):
+    nz, ny, nx = density.shape
+    extent = np.array([(nx - 1) * spacing[0], (ny - 1) * spacing[1], (nz - 1) * spacing[2]])
+    centre = extent / 2
+    # From the anterior-left side and a little above, as a user would look at a head.
+    direction = np.array([0.55, -1.0, 0.35])
+    direction /= np.linalg.norm(direction)
+    position = centre + direction * 1.5 * np.linalg.norm(extent)
+    return {"position": position.tolist(), "look_at": centre.tolist(), "up": [0.0, 0.0, 1.0], "fov": 30.0}, extent
+
+
+def render_ours(folder, cam, size, spp, seed):
+    scene = {
+        "volumes": {"scalars": {"file": "extinction.nrrd"}, "albedo_t": {"file": "albedo_t.nrrd"}},
+        "materials": {"medium": {
+            "density": SIGMA_MAX, "albedo": [1, 1, 1], "anisotropy": G, "surface_probability": 0,
+            "tfs": {"density": [{"type": "cctf", "proxy": "scalars", "points": [[0, 0], [1, 1]]}],
+                    "albedo": [{"type": "cctf", "proxy": "albedo_t",
+                                "points": [[0, *ALBEDO_LOW], [1, *ALBEDO_HIGH]]}]}}},
+        "lights": [{"type": "environment", "color": list(ENVIRONMENT)},
+                   {"type": "directional", "direction": list(SUN_DIRECTION), "color": list(SUN_IRRADIANCE),
+                    "intensity": 1.0}],
+        "camera": {"projection": "perspective", **cam},
+        "render": {"max_bounces": MAX_BOUNCES, "shadow_extinction_scale": 1.0, "background": True},
+    }
+    path = Path(folder) / "scene.json"
+    path.write_text(json.dumps(scene, indent=1))
+    return acc.render(["--scene", path], size, size, spp, seed=seed)
+
+
+def render_mitsuba(variant, density, albedo_t, spacing, extent, cam, size, spp, batches):
+    import mitsuba as mi
+    mi.set_variant(variant)
+    T = mi.ScalarTransform4f
+    nz, ny, nx = density.shape
+    albedo = (np.array(ALBEDO_LOW) + albedo_t[..., None] * (np.array(ALBEDO_HIGH) - np.array(ALBEDO_LOW)))
+    # A gridvolume puts voxel i's value at (i + 0.5) / n of its unit cube, so
+    # the cube is widened by half a voxel to put voxel centres where ours are.
+    half_voxel = np.array(spacing) / 2
+    volume_to_world = T().translate((-half_voxel).tolist()).scale((extent + 2 * half_voxel).tolist())
+    grid = {"to_world": volume_to_world, "filter_type": "trilinear"}
+    scene = mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "volpath", "max_depth": MAX_BOUNCES + 1, "rr_depth": 5},
+        "sensor": {"type": "perspective", "fov": cam["fov"], "fov_axis": "y",
+                   "to_world": T().look_at(origin=cam["position"], target=cam["look_at"], up=cam["up"]),
+                   "sampler": {"type": "independent", "sample_count": spp},
+                   "film": {"type": "hdrfilm", "width": size, "height": size, "rfilter": {"type": "box"},
+                            "pixel_format": "rgb"}},
+        "environment": {"type": "constant", "radiance": {"type": "rgb", "value": list(ENVIRONMENT)}},
+        "sun": {"type": "directional", "direction": list(SUN_DIRECTION),
+                "irradiance": {"type": "rgb", "value": list(SUN_IRRADIANCE)}},
+        "medium_box": {
+            "type": "cube", "to_world": T().translate((extent / 2).tolist()).scale((extent / 2).tolist()),
+            "bsdf": {"type": "null"},
+            "interior": {"type": "heterogeneous", "scale": SIGMA_MAX, "phase": {"type": "hg", "g": G},
+                         "sigma_t": {"type": "gridvolume", "grid": mi.VolumeGrid(density[..., None].astype(np.float32)),
+                                     **grid},
+                         "albedo": {"type": "gridvolume", "grid": mi.VolumeGrid(albedo.astype(np.float32)), **grid}}},
+    })
+    images, seconds = [], 0.0
+    for b in range(batches):
+        start = time.time()
+        image = np.array(mi.render(scene, spp=spp, seed=1 + b), dtype=np.float64)[..., :3]
+        if b > 0 or not variant.startswith("llvm"):  # the first LLVM batch includes the kernel compilation
+            seconds += time.time() - start
+        images.append(image)
+    images = np.stack(images)
+    timed_batches = batches if not variant.startswith("llvm") else batches - 1
+    mean = images.mean(axis=0)
+    variance_of_mean = images.var(axis=0, ddof=1) / batches
+    return mean, variance_of_mean, seconds / max(timed_batches, 1) * batches
+
+
+def block_sums(image, block):
+    h, w, c = image.shape
+    return image[:h - h % block, :w - w % block].reshape(h // block, block, w // block, block, c).sum(axis=(1, 3))
+
+
+def compare(ours_mean, ours_var, mi_mean, mi_var, block=8):
+    n = block * block
+    a, b = block_sums(ours_mean, block) / n, block_sums(mi_mean, block) / n
+    va, vb = block_sums(ours_var, block) / n ** 2, block_sums(mi_var, block) / n ** 2
+    var = va + vb
+    # Blocks without noise (only the constant environment; float rounding in
+    # the running variance leaves ~1e-15 there) must agree to float precision.
+    noisy = var > (1e-5 * (np.abs(b) + 1e-3)) ** 2
+    silent_mismatch = int(np.sum(~noisy & (np.abs(a - b) > 1e-5 * np.abs(b) + 1e-7)))
+    z2 = (a - b)[noisy] ** 2 / var[noisy]
+    k = z2.size
+    return {"mean_z2": float(z2.mean()), "terms": k, "limit": 1 + 5 * math.sqrt(2 / k),
+            "noiseless_blocks_that_differ": silent_mismatch,
+            "mean_ratio": float(ours_mean.mean() / mi_mean.mean()),
+            "mean_ratio_sigma": float(math.sqrt(ours_var.sum() + mi_var.sum()) / ours_mean.size / mi_mean.mean()),
+            "max_abs_block_z": float(np.sqrt(z2).max())}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--ci", action="store_true", help="48 x 48, few samples: the CTest check")
+    parser.add_argument("--size", type=int)
+    parser.add_argument("--spp", type=int, help="our samples per pixel")
+    parser.add_argument("--mitsuba-spp", type=int, help="Mitsuba's samples per pixel per batch")
+    parser.add_argument("--batches", type=int, default=16, help="independent Mitsuba batches (for its variance)")
+    parser.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb or llvm_ad_rgb)")
+    parser.add_argument("--save", help="folder for both images (PFM and PNG) and the figures (JSON)")
+    args = parser.parse_args()
+    size = args.size or (48 if args.ci else 256)
+    spp = args.spp or (1024 if args.ci else 4096)
+    mi_spp = args.mitsuba_spp or max(1, spp // args.batches)
+    try:
+        import mitsuba  # noqa: F401
+    except ImportError:
+        print("SKIPPED: Mitsuba 3 is not installed for this Python "
+              f"({sys.executable}); scripts/install-dependencies.sh installs it in .venv")
+        return SKIP
+    density, albedo_t, spacing = make_grids()
+    cam, extent = camera(density, spacing)
+    with tempfile.TemporaryDirectory() as tmp:
+        write_nrrd(Path(tmp) / "extinction.nrrd", density, spacing)
+        write_nrrd(Path(tmp) / "albedo_t.nrrd", albedo_t, spacing)
+        start = time.time()
+        ours = render_ours(tmp, cam, size, spp, seed=3)
+        ours_seconds = ours.seconds
+        print(f"mmrtm-render: {size}^2, {spp} spp, {ours_seconds:.2f} s render ({time.time() - start:.1f} s in all)")
+    mi_mean, mi_var, mi_seconds = render_mitsuba(args.variant, density, albedo_t, spacing, extent, cam, size,
+                                                 mi_spp, args.batches)
+    print(f"Mitsuba {args.variant}: {size}^2, {args.batches} x {mi_spp} spp, {mi_seconds:.2f} s render")
+    result = compare(ours.mean, ours.variance, mi_mean, mi_var)
+    ours_noise = acc.reference_noise(ours.mean, ours.variance)
+    mi_noise = acc.reference_noise(mi_mean, mi_var)
+    # Time to reach a given relative noise e: t * (noise / e)^2; the ratio does not depend on e.
+    result.update({"size": size, "ours_spp": spp, "ours_seconds": ours_seconds, "ours_noise": ours_noise,
+                   "mitsuba_variant": args.variant, "mitsuba_spp": mi_spp * args.batches,
+                   "mitsuba_seconds": mi_seconds, "mitsuba_noise": mi_noise,
+                   "time_to_equal_error_ratio": (mi_seconds * mi_noise ** 2) / (ours_seconds * ours_noise ** 2),
+                   "mean_luminance": float(ours.mean.mean())})
+    print(json.dumps(result, indent=1))
+    if args.save:
+        out = Path(args.save)
+        out.mkdir(parents=True, exist_ok=True)
+        acc.write_pfm(out / "mmrtm.pfm", ours.mean)
+        acc.write_pfm(out / "mitsuba.pfm", mi_mean)
+        (out / "mitsuba_check.json").write_text(json.dumps(result, indent=1))
+    ok = (result["mean_z2"] <= result["limit"] and result["noiseless_blocks_that_differ"] == 0
+          and result["mean_luminance"] > 0.01)
+    print(("PASS" if ok else "FAIL") + f": mean block z^2 {result['mean_z2']:.3f} (limit {result['limit']:.3f}); "
+          f"mean ratio ours / Mitsuba {result['mean_ratio']:.4f} +- {result['mean_ratio_sigma']:.4f}; "
+          f"Mitsuba needs {result['time_to_equal_error_ratio']:.2f} x our time for the same error")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,158 @@
+"""Shared pieces of the accuracy and speed scripts: where things are, how a
+render is run, PFM images, and the error measure.
+
+The scripts call the command-line renderer (`mmrtm-render`) rather than a
+library, so what they measure is what a user runs. Paths come from the
+environment when set:
+
+  MMRTM_BUILD_DIR       the CMake build folder (default: <repo>/build)
+  MMRTM_SHARED_DATA     the shared datasets (default: <repo>/../shared/data)
+  MMRTM_REFERENCE_DIR   converged reference images (default: <build>/references)
+"""
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILD = Path(os.environ.get("MMRTM_BUILD_DIR", ROOT / "build"))
+DATA = Path(os.environ.get("MMRTM_SHARED_DATA", ROOT.parent / "shared" / "data"))
+REFERENCE_DIR = Path(os.environ.get("MMRTM_REFERENCE_DIR", BUILD / "references"))
+RENDER = BUILD / "bin" / "mmrtm-render"
+DOC_IMAGES = ROOT / "Documentation" / "images"
+
+
+def _data(name):
+    return str(DATA / name)
+
+
+# The reference scenes of Documentation/accuracy.md: input and options of
+# mmrtm-render. Every one is 256 x 256 and uses the scene's own camera.
+SCENES = {
+    "head_ct_bone": {
+        "title": "head CT, ct-bone",
+        "args": [_data("ct_head_cranium.nrrd"), "--preset", "ct-bone"],
+    },
+    "chest_ct": {
+        "title": "chest CT (DICOM), ct-soft-tissue",
+        "args": [_data("ct_chest_dicom"), "--preset", "ct-soft-tissue"],
+    },
+    "cta_labels": {
+        "title": "chest CTA, vessel labels as materials",
+        "args": [_data("cta_chest_aorta.nii.gz"), "--labels", _data("cta_chest_aorta_labels.nii.gz"),
+                 "--preset", "ct-angio-labels"],
+    },
+    "bonsai": {
+        "title": "bonsai",
+        "args": [_data("bonsai.nii.gz"), "--scene", str(ROOT / "Data" / "benchmarks" / "bonsai.json")],
+    },
+    "mri_labels": {
+        "title": "MRI head, brain and skull labels",
+        "args": [_data("mr_head.nii.gz"), "--labels", _data("mr_head_labels.nii.gz"),
+                 "--scene", str(ROOT / "Data" / "benchmarks" / "mr_head_labels.json")],
+    },
+}
+
+REFERENCE_SIZE = 256
+
+
+def read_pfm(path):
+    """A colour PFM as a (height, width, 3) float64 array, row 0 at the top."""
+    with open(path, "rb") as f:
+        kind = f.readline().strip()
+        if kind != b"PF":
+            raise ValueError(f"{path}: not a colour PFM (header {kind!r})")
+        width, height = (int(v) for v in f.readline().split())
+        scale = float(f.readline())
+        dtype = "<f4" if scale < 0 else ">f4"
+        data = np.fromfile(f, dtype=dtype, count=width * height * 3)
+    if data.size != width * height * 3:
+        raise ValueError(f"{path}: truncated ({data.size} of {width * height * 3} floats)")
+    return np.flipud(data.reshape(height, width, 3)).astype(np.float64)
+
+
+def write_pfm(path, image):
+    image = np.asarray(image, dtype="<f4")
+    height, width, _ = image.shape
+    tmp = str(path) + ".partial"
+    with open(tmp, "wb") as f:
+        f.write(f"PF\n{width} {height}\n-1.0\n".encode())
+        np.flipud(image).tofile(f)
+    os.replace(tmp, path)
+
+
+class Render:
+    """One run of mmrtm-render: mean image, variance of the mean, and its --stats-json."""
+
+    def __init__(self, mean, variance, stats):
+        self.mean, self.variance, self.stats = mean, variance, stats
+
+    @property
+    def seconds(self):
+        return self.stats["seconds"]["render"]
+
+
+def render(args, width, height, spp, seed=0, extra=(), keep=None):
+    """Runs mmrtm-render with `args` (input and scene options) and returns a Render.
+
+    `keep`, a path prefix, also keeps PREFIX.pfm, PREFIX_variance.pfm,
+    PREFIX.png and PREFIX.json; otherwise everything goes to a temporary folder.
+    """
+    if not RENDER.exists():
+        sys.exit(f"{RENDER}: not built (cmake --build build)")
+    with tempfile.TemporaryDirectory() as tmp:
+        prefix = Path(keep) if keep else Path(tmp) / "render"
+        cmd = [str(RENDER), *map(str, args), "--width", str(width), "--height", str(height),
+               "--spp", str(spp), "--seed", str(seed), "--quiet",
+               "--output", f"{prefix}.png", "--output-linear", f"{prefix}.pfm",
+               "--output-variance", f"{prefix}_variance.pfm", "--stats-json", f"{prefix}.json", *map(str, extra)]
+        done = subprocess.run(cmd, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError(f"mmrtm-render failed ({done.returncode}): {' '.join(cmd)}\n{done.stderr}")
+        with open(f"{prefix}.json") as f:
+            stats = json.load(f)
+        return Render(read_pfm(f"{prefix}.pfm"), read_pfm(f"{prefix}_variance.pfm"), stats)
+
+
+def relative_rmse(image, reference, reference_variance=None):
+    """RMSE over pixels and channels divided by the reference's mean value.
+
+    With `reference_variance` (the variance of the reference's per-pixel mean),
+    the reference's own noise is taken out: E[(a - r)^2] = E[(a - R)^2] + Var[r]
+    for a reference r of true value R that is independent of a, so the
+    variance is subtracted from the mean squared error (clamped at 0).
+    """
+    squared = np.mean((image - reference) ** 2)
+    if reference_variance is not None:
+        squared = max(0.0, squared - np.mean(reference_variance))
+    return float(np.sqrt(squared) / np.mean(reference))
+
+
+def reference_noise(reference, reference_variance):
+    """The reference's own relative RMS noise (same scale as relative_rmse)."""
+    return float(np.sqrt(np.mean(reference_variance)) / np.mean(reference))
+
+
+def mean_squared_z(a, b):
+    """Mean over pixels and channels of (a - b)^2 / (var_a + var_b), pixels with variance only.
+
+    About 1 when two independent renders estimate the same image, well above 1
+    when they differ. Arguments are Render objects."""
+    var = a.variance + b.variance
+    mask = var > 0
+    return float(np.mean((a.mean - b.mean)[mask] ** 2 / var[mask]))
+
+
+def load_reference(name):
+    """(mean, variance, metadata) of a reference made by make_references.py, or None."""
+    mean = REFERENCE_DIR / f"{name}.pfm"
+    if not mean.exists():
+        return None
+    with open(REFERENCE_DIR / f"{name}.json") as f:
+        meta = json.load(f)
+    return read_pfm(mean), read_pfm(REFERENCE_DIR / f"{name}_variance.pfm"), meta

@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""Speed against accuracy: relative RMSE against render time and against
+samples per pixel, for delta tracking with each accelerator and for ray
+marching at several step sizes, on every reference scene.
+
+    Testing/Accuracy/speed_accuracy.py [--max-spp N] [--only NAME ...]
+
+Needs the references of make_references.py. Writes
+Documentation/images/speed_accuracy_NAME.png and the numbers to
+MMRTM_REFERENCE_DIR/speed_accuracy.json. The reference's own variance is
+subtracted from each squared error (mmrtm_accuracy.relative_rmse), and the
+reference's relative noise is drawn as a dotted line. Every render uses the
+unbiased shadow rays (--shadow-scale 1), as the references do.
+"""
+
+import argparse
+import json
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+import mmrtm_accuracy as acc  # noqa: E402
+
+SEED = 7  # differs from make_references.REFERENCE_SEED: independent noise
+
+METHODS = [
+    # label, options, colour, line style
+    ("delta, no accelerator", ["--accelerator", "none"], "tab:gray", "-"),
+    ("delta, macrocell", ["--accelerator", "macrocell"], "tab:blue", "-"),
+    ("delta, octree (default)", ["--accelerator", "octree"], "tab:green", "-"),
+    ("delta, octree-voxelmax", ["--accelerator", "octree-voxelmax"], "tab:olive", "--"),
+    ("ray marching 2 mm", ["--estimator", "raymarch", "--ray-march-step", "2"], "tab:red", ":"),
+    ("ray marching 1 mm", ["--estimator", "raymarch", "--ray-march-step", "1"], "tab:orange", ":"),
+    ("ray marching 0.5 mm", ["--estimator", "raymarch", "--ray-march-step", "0.5"], "tab:purple", ":"),
+    ("ray marching 0.25 mm", ["--estimator", "raymarch", "--ray-march-step", "0.25"], "tab:brown", ":"),
+]
+
+
+def measure(name, max_spp, size):
+    ref = acc.load_reference(name)
+    if ref is None:
+        raise SystemExit(f"no reference for {name} in {acc.REFERENCE_DIR}: run make_references.py first")
+    ref_mean, ref_var, ref_meta = ref
+    if ref_mean.shape[0] != size:
+        raise SystemExit(f"reference {name} is {ref_mean.shape[1]}x{ref_mean.shape[0]}, not {size}^2")
+    result = {"reference_spp": ref_meta["spp"], "reference_noise": acc.reference_noise(ref_mean, ref_var),
+              "methods": {}}
+    ladder = [s for s in (1, 2, 4, 8, 16, 32, 64, 128, 256, 512) if s <= max_spp]
+    for label, options, _, _ in METHODS:
+        rows = []
+        for spp in ladder:
+            r = acc.render(acc.SCENES[name]["args"], size, size, spp, seed=SEED,
+                           extra=["--shadow-scale", "1", *options])
+            rows.append({"spp": spp, "seconds": r.seconds,
+                         "rel_rmse": acc.relative_rmse(r.mean, ref_mean, ref_var),
+                         "density_lookups": r.stats["density_lookups"],
+                         "real_collisions": r.stats["real_collisions"]})
+            print(f"  {name:13s} {label:26s} {spp:4d} spp {r.seconds:7.2f} s  rel. RMSE {rows[-1]['rel_rmse']:.4f}",
+                  flush=True)
+        result["methods"][label] = rows
+    return result
+
+
+def chart(name, result, path):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for label, _, colour, style in METHODS:
+        rows = result["methods"].get(label)
+        if not rows:
+            continue
+        axes[0].loglog([r["seconds"] for r in rows], [r["rel_rmse"] for r in rows], style, color=colour,
+                       marker="o", ms=3, label=label)
+        axes[1].loglog([r["spp"] for r in rows], [r["rel_rmse"] for r in rows], style, color=colour, marker="o",
+                       ms=3, label=label)
+    for ax in axes:
+        ax.axhline(result["reference_noise"], color="k", lw=0.8, ls=(0, (1, 3)),
+                   label=f"reference's own noise ({result['reference_spp']} spp)")
+        ax.grid(True, which="both", lw=0.3)
+        ax.set_ylabel("relative RMSE (reference variance subtracted)")
+    axes[0].set_xlabel("render time, s (2 CPU cores)")
+    axes[1].set_xlabel("samples per pixel")
+    axes[1].legend(fontsize=7, loc="lower left")
+    fig.suptitle(f"{acc.SCENES[name]['title']}: error against time and samples (256 x 256)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--max-spp", type=int, default=128)
+    parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
+    parser.add_argument("--charts-only", action="store_true", help="redraw from speed_accuracy.json")
+    args = parser.parse_args()
+    store = acc.REFERENCE_DIR / "speed_accuracy.json"
+    results = json.loads(store.read_text()) if store.exists() else {}
+    for name in args.only or list(acc.SCENES):
+        if not args.charts_only:
+            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE)
+            store.write_text(json.dumps(results, indent=1))
+        if name in results:
+            chart(name, results[name], acc.DOC_IMAGES / f"speed_accuracy_{name}.png")
+            print(f"wrote {acc.DOC_IMAGES / f'speed_accuracy_{name}.png'}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,216 @@
+// Failure cases (Documentation/accuracy.md, "Where methods fail"): each test
+// shows the failure of a baseline where there is one, and that the default
+// (delta and ratio tracking on the conservative octree) survives it.
+// Tolerances are kSigmas standard errors of each estimator, from the
+// estimator's own variance; the fixed seeds make every run identical.
+// A volume of one voxel and a 1 x 1 x 1000 volume are refused with a clear
+// message: test_mmrtm_render_cli.py (test_degenerate_volumes).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "FailureCaseScenes.h"
+#include "cpu_renderer.h"
+#include "film.h"
+#include "mmrtm/integrator.h"
+
+namespace mmrtm {
+namespace {
+
+using failure::Estimate;
+using failure::Method;
+
+constexpr int kTrials = 100000;
+constexpr double kSigmas = 4.0;
+
+Estimate Measure(failure::Case& c, Method m, int trials = kTrials) {
+  SceneView s = c.scene.Build();
+  return failure::Transmittance(s, c.ray, m, trials, 1);
+}
+
+// --- A narrow TF peak -------------------------------------------------------
+
+TEST(NarrowTFPeak, DeltaAndRatioTrackingOnTheOctreeAreExact) {
+  for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
+    failure::Case c = failure::NarrowPeak(0.1f, 8.f, MajorantKind::Octree, SummaryMode::CellRanges);
+    Estimate e = Measure(c, m);
+    EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError) << "method " << (int)m;
+    EXPECT_EQ(e.violations, 0u);
+  }
+}
+
+TEST(NarrowTFPeak, RayMarchingStepsOverIt) {
+  // The peak is 0.2 mm wide, the step 1 mm: most marches miss it and those
+  // that hit it count a whole step of it, so the transmittance is too high
+  // (Jensen: E[exp(-X)] > exp(-E[X]) for the jittered sum X).
+  failure::Case c = failure::NarrowPeak(0.1f, 8.f, MajorantKind::Octree, SummaryMode::CellRanges, 1.f);
+  Estimate e = Measure(c, Method::RayMarching);
+  EXPECT_GT(e.mean - c.exact, 0.1) << "ray marching " << e.mean << " vs exact " << c.exact;
+  // A step well below the peak's width resolves it.
+  failure::Case fine = failure::NarrowPeak(0.1f, 8.f, MajorantKind::Octree, SummaryMode::CellRanges, 0.01f);
+  Estimate ef = Measure(fine, Method::RayMarching, 5000);  // 2000 lookups a ray
+  EXPECT_NEAR(ef.mean, fine.exact, 0.02);
+}
+
+TEST(NarrowTFPeak, VoxelMaxMajorantSkipsIt) {
+  // No voxel value lies in the peak, so the paper's voxel-value refit gives
+  // every node a zero majorant: tracking sees an empty volume (T = 1).
+  failure::Case c = failure::NarrowPeak(0.1f, 8.f, MajorantKind::Octree, SummaryMode::VoxelValues);
+  Estimate e = Measure(c, Method::DeltaTracking);
+  EXPECT_GT(e.mean - c.exact, 0.3) << "voxel-max " << e.mean << " vs exact " << c.exact;
+}
+
+// --- A sparse dense structure in a large empty volume -------------------------
+
+TEST(SparseDenseStructure, GlobalMajorantIsSlowAndTheOctreeIsNot) {
+  failure::Case global = failure::SparseBlock(128, 1.f, MajorantKind::Global);
+  failure::Case octree = failure::SparseBlock(128, 1.f, MajorantKind::Octree);
+  Estimate g = Measure(global, Method::RatioTracking), o = Measure(octree, Method::RatioTracking);
+  // Both are exact...
+  EXPECT_NEAR(g.mean, global.exact, kSigmas * g.standardError);
+  EXPECT_NEAR(o.mean, octree.exact, kSigmas * o.standardError);
+  // ...but the global majorant (1 / mm) steps through the whole 128 mm.
+  EXPECT_GT(g.lookupsPerRay, 50.0);  // fewer than 128: roulette ends some rays after the block
+  EXPECT_LT(o.lookupsPerRay, g.lookupsPerRay / 10.0);
+  std::printf("lookups per ray: global %.1f, octree %.1f\n", g.lookupsPerRay, o.lookupsPerRay);
+}
+
+// --- Very dense media --------------------------------------------------------
+
+struct PathCost {
+  double lookupsPerPath, realPerPath;
+  uint64_t maxRealPerPath;
+};
+
+// Paths from a camera into a ball of density `density` (smooth edge, 1 mm
+// voxels), rendered one path at a time to see each path's own count.
+PathCost DensePathCost(float density, RGB albedo, int maxBounces) {
+  Scene scene = test::MakeMediumScene(test::MakeVolume(33, 33, 33,
+                                                       [](int i, int j, int k) {
+                                                         float r = std::sqrt(float((i - 16) * (i - 16) + (j - 16) * (j - 16) + (k - 16) * (k - 16)));
+                                                         return std::clamp(12.f - r, 0.f, 1.f);
+                                                       }),
+                                      density, albedo);
+  scene.environment = EnvironmentMap::Constant(RGB(1.f));
+  scene.render.integrator.maxBounces = maxBounces;
+  scene.render.width = scene.render.height = 16;
+  SceneView s = scene.Build();
+  PathCost cost{0, 0, 0};
+  TraceCounters total;
+  int paths = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (uint32_t i = 0; i < 8; ++i) {
+        TraceCounters ctr;
+        RenderPixelSample(s, x, y, i, ctr);
+        cost.maxRealPerPath = std::max<uint64_t>(cost.maxRealPerPath, ctr.realCollisions);
+        total.densityLookups += ctr.densityLookups;
+        total.realCollisions += ctr.realCollisions;
+        ++paths;
+      }
+  cost.lookupsPerPath = (double)total.densityLookups / paths;
+  cost.realPerPath = (double)total.realCollisions / paths;
+  return cost;
+}
+
+TEST(VeryDenseMedia, TheBounceLimitBoundsRealCollisions) {
+  // Albedo 1: Russian roulette never fires (the throughput stays 1), so only
+  // the bounce limit ends a path in a medium it cannot leave.
+  PathCost dense = DensePathCost(1e4f, RGB(1.f), 8);
+  EXPECT_EQ(dense.maxRealPerPath, 9u) << "bounce limit 8: at most 8 scatterings and the collision that ends it";
+  // Albedo 0.5: Russian roulette ends most paths well before the limit.
+  PathCost absorbing = DensePathCost(1e4f, RGB(0.5f), 32);
+  EXPECT_LE(absorbing.maxRealPerPath, 33u);
+  EXPECT_LT(absorbing.realPerPath, 4.0);
+}
+
+TEST(VeryDenseMedia, LookupsGrowNoFasterThanTheDensity) {
+  // Null collisions are not bounded by the bounce limit: in a leaf that is
+  // part empty, part dense, tracking takes ~majorant x empty length steps.
+  // They must stay bounded by that (linear in the density), not explode.
+  PathCost d2 = DensePathCost(1e2f, RGB(0.8f), 32), d4 = DensePathCost(1e4f, RGB(0.8f), 32);
+  std::printf("lookups per path: density 1e2 %.1f, 1e4 %.1f; real collisions per path %.2f, %.2f\n",
+              d2.lookupsPerPath, d4.lookupsPerPath, d2.realPerPath, d4.realPerPath);
+  EXPECT_LT(d4.lookupsPerPath, 100.0 * 1.1 * d2.lookupsPerPath);
+  EXPECT_LT(d4.realPerPath, 4.0);
+}
+
+// --- Grazing rays along slices ----------------------------------------------
+
+TEST(GrazingRays, AlongASliceOnANodeFace) {
+  // z = 16 is a voxel slice and a face between nodes at every level.
+  for (MajorantKind kind : {MajorantKind::Macrocell, MajorantKind::Octree}) {
+    for (float z : {16.f, 16.f + 1e-5f, 16.f - 1e-5f, 16.5f, 15.f}) {
+      failure::Case c = failure::SliceSheet(z, 0.05f, kind);
+      for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
+        Estimate e = Measure(c, m);
+        EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError + 1e-6)
+            << "z " << z << " kind " << (int)kind << " method " << (int)m;
+        EXPECT_EQ(e.violations, 0u);
+      }
+    }
+  }
+}
+
+TEST(GrazingRays, TippedAcrossTheSheet) {
+  for (float tilt : {1e-4f, 1e-2f}) {
+    failure::Case c = failure::SliceSheet(16.f, 0.05f, MajorantKind::Octree, tilt);
+    Estimate e = Measure(c, Method::RatioTracking);
+    EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError + 1e-4) << "tilt " << tilt;
+    EXPECT_EQ(e.violations, 0u);
+  }
+}
+
+// --- Degenerate TFs ---------------------------------------------------------
+
+Film RenderAbsorbing(Scene& scene, TraceCounters* ctr) {
+  scene.environment = EnvironmentMap::Constant(RGB(0.3f, 0.4f, 0.5f));
+  scene.render.width = scene.render.height = 24;
+  SceneView view = scene.Build();
+  Film film(24, 24);
+  CpuRenderer(2).Render(view, film, 4, ctr);
+  return film;
+}
+
+TEST(DegenerateTF, AllZeroShowsTheEnvironmentWithoutALookup) {
+  Scene scene = failure::SceneWithTF(test::MakeConstantVolume(16, 100.f), failure::CCTF({0.f, 1000.f}, {0.f, 0.f}),
+                                     1.f, MajorantKind::Octree);
+  TraceCounters ctr;
+  Film film = RenderAbsorbing(scene, &ctr);
+  EXPECT_EQ(ctr.densityLookups, 0u) << "an empty grid needs no lookup";
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 24; ++x) {
+      RGB p = film.Mean(x, y);
+      EXPECT_FLOAT_EQ(p.r, 0.3f);
+      EXPECT_FLOAT_EQ(p.b, 0.5f);
+    }
+}
+
+TEST(DegenerateTF, AllOneIsAHomogeneousBox) {
+  // A constant TF of 1 over noisy data: Beer-Lambert through the box.
+  for (MajorantKind kind : {MajorantKind::Global, MajorantKind::Octree}) {
+    failure::Case c{failure::SceneWithTF(test::MakeVolume(17, 17, 17, [](int i, int j, int k) { return float((i * 31 + j * 17 + k * 7) % 100); }),
+                                         failure::CCTF({0.f, 99.f}, {1.f, 1.f}), 0.1f, kind),
+                    Ray{{-2.f, 8.3f, 8.6f}, {1.f, 0.f, 0.f}}, std::exp(-0.1 * 16.0)};
+    for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
+      Estimate e = Measure(c, m);
+      EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError) << "kind " << (int)kind;
+      if (kind == MajorantKind::Octree && m == Method::RatioTracking)
+        EXPECT_LT(e.lookupsPerRay, 0.1 * 16.0 * 1.5 + 1.0) << "a tight majorant: about sigma x length lookups";
+    }
+  }
+}
+
+TEST(DegenerateTF, StepAtTheDataMaximum) {
+  for (MajorantKind kind : {MajorantKind::Global, MajorantKind::Macrocell, MajorantKind::Octree}) {
+    failure::Case c = failure::SaturatedBlock(0.4f, kind);
+    for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
+      Estimate e = Measure(c, m);
+      EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError + 1e-3) << "kind " << (int)kind;
+      EXPECT_EQ(e.violations, 0u);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mmrtm
