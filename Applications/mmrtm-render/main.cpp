@@ -22,6 +22,7 @@
 #include "mmrtmVolumeLoader.h"
 #include "render_backend.h"
 #include "scene_json.h"
+#include "scene_relocation.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -72,6 +73,24 @@ options:
   --quiet               no progress bar
   --help                this text
 )";
+
+// What the scene holds in memory while rendering, against the input volumes
+// (DESIGN.md rule 3: no more than the scene needs). The majorant grid's
+// value summaries stay on the host (refits read them); the rest is what a
+// GPU backend uploads.
+json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t inputVoxelBytes) {
+  const mmrtm::SceneFootprint f = mmrtm::MeasureSceneView(view);
+  size_t summaries = 0;
+  if (const mmrtm::MajorantGrid* grid = scene.Grid())
+    for (int k = 0; k < grid->ProxyCount(); ++k) summaries += grid->Summaries(k).size() * sizeof(uint64_t);
+  const auto& dims = scene.proxies.at(0).dims;
+  const double voxels = (double)dims[0] * dims[1] * dims[2];
+  const size_t held = f.voxels + f.tables + f.majorants + summaries;
+  return {{"input_voxel_bytes", inputVoxelBytes}, {"proxy_voxel_bytes", f.voxels}, {"tf_table_bytes", f.tables},
+          {"majorant_bytes", f.majorants}, {"summary_bytes", summaries}, {"environment_bytes", f.environment},
+          {"voxels", voxels}, {"bytes_per_voxel", held / voxels},
+          {"input_bytes_per_voxel", inputVoxelBytes / voxels}};
+}
 
 struct Options {
   std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear,
@@ -260,6 +279,8 @@ int Run(const Options& o) {
     inputs.volumes["labels"] = mmrtm::LoadVolume(o.labels, "labels", mmrtm::Interpolation::Nearest);
   }
   const double loadSeconds = SecondsSince(tStart);
+  size_t inputVoxelBytes = 0;  // the volumes as read, in their own voxel types
+  for (const auto& [name, volume] : inputs.volumes) inputVoxelBytes += volume.voxels.size();
 
   const auto tBuild = std::chrono::steady_clock::now();
   mmrtm::Scene scene = mmrtm::SceneFromJson(doc, std::move(inputs));
@@ -316,6 +337,7 @@ int Run(const Options& o) {
         {"majorant_violations", counters.majorantViolations},
         {"density_lookups_per_real_collision",
          counters.realCollisions ? (double)counters.densityLookups / counters.realCollisions : 0.0},
+        {"memory", MemoryJson(scene, view, inputVoxelBytes)},
         {"noise", {{"mean_luminance", noise.meanLuminance}, {"rms_standard_error", noise.rmsStandardError},
                    {"relative", noise.relative}}}};
     const std::string tmp = o.statsJson + ".partial";

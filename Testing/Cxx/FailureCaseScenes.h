@@ -21,6 +21,7 @@
 #include <cstdint>
 
 #include "TestSceneHelpers.h"
+#include "mmrtm/integrator.h"
 #include "mmrtm/rng.h"
 #include "mmrtm/tracking.h"
 
@@ -155,6 +156,45 @@ inline Case SaturatedBlock(float density, MajorantKind kind) {
                      CCTF({254.999f, 255.f}, {0.f, 1.f}), density, kind),
          Ray{{-1.f, 15.f, 16.f}, {1.f, 0.f, 0.f}}, std::exp(-3.0 * density)};
   return c;
+}
+
+// --- Very dense media: the cost of whole paths ---
+
+struct PathCost {
+  double lookupsPerPath, realPerPath;
+  uint64_t maxRealPerPath;
+};
+
+// Paths from a camera into a ball of density `density` (smooth edge, 1 mm
+// voxels), rendered one path at a time to see each path's own count.
+inline PathCost DensePathCost(float density, RGB albedo, int maxBounces, int leafLevel = -1) {
+  Scene scene = test::MakeMediumScene(test::MakeVolume(33, 33, 33,
+                                                       [](int i, int j, int k) {
+                                                         float r = std::sqrt(float((i - 16) * (i - 16) + (j - 16) * (j - 16) + (k - 16) * (k - 16)));
+                                                         return std::clamp(12.f - r, 0.f, 1.f);
+                                                       }),
+                                      density, albedo);
+  scene.environment = EnvironmentMap::Constant(RGB(1.f));
+  scene.render.integrator.maxBounces = maxBounces;
+  scene.render.accelerator.grid.leafLevel = leafLevel;
+  scene.render.width = scene.render.height = 16;
+  SceneView s = scene.Build();
+  PathCost cost{0, 0, 0};
+  TraceCounters total;
+  int paths = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (uint32_t i = 0; i < 8; ++i) {
+        TraceCounters ctr;
+        RenderPixelSample(s, x, y, i, ctr);
+        cost.maxRealPerPath = std::max<uint64_t>(cost.maxRealPerPath, ctr.realCollisions);
+        total.densityLookups += ctr.densityLookups;
+        total.realCollisions += ctr.realCollisions;
+        ++paths;
+      }
+  cost.lookupsPerPath = (double)total.densityLookups / paths;
+  cost.realPerPath = (double)total.realCollisions / paths;
+  return cost;
 }
 
 }  // namespace mmrtm::failure

@@ -12,7 +12,6 @@
 #include "FailureCaseScenes.h"
 #include "cpu_renderer.h"
 #include "film.h"
-#include "mmrtm/integrator.h"
 
 namespace mmrtm {
 namespace {
@@ -77,49 +76,13 @@ TEST(SparseDenseStructure, GlobalMajorantIsSlowAndTheOctreeIsNot) {
 
 // --- Very dense media --------------------------------------------------------
 
-struct PathCost {
-  double lookupsPerPath, realPerPath;
-  uint64_t maxRealPerPath;
-};
-
-// Paths from a camera into a ball of density `density` (smooth edge, 1 mm
-// voxels), rendered one path at a time to see each path's own count.
-PathCost DensePathCost(float density, RGB albedo, int maxBounces) {
-  Scene scene = test::MakeMediumScene(test::MakeVolume(33, 33, 33,
-                                                       [](int i, int j, int k) {
-                                                         float r = std::sqrt(float((i - 16) * (i - 16) + (j - 16) * (j - 16) + (k - 16) * (k - 16)));
-                                                         return std::clamp(12.f - r, 0.f, 1.f);
-                                                       }),
-                                      density, albedo);
-  scene.environment = EnvironmentMap::Constant(RGB(1.f));
-  scene.render.integrator.maxBounces = maxBounces;
-  scene.render.width = scene.render.height = 16;
-  SceneView s = scene.Build();
-  PathCost cost{0, 0, 0};
-  TraceCounters total;
-  int paths = 0;
-  for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 16; ++x)
-      for (uint32_t i = 0; i < 8; ++i) {
-        TraceCounters ctr;
-        RenderPixelSample(s, x, y, i, ctr);
-        cost.maxRealPerPath = std::max<uint64_t>(cost.maxRealPerPath, ctr.realCollisions);
-        total.densityLookups += ctr.densityLookups;
-        total.realCollisions += ctr.realCollisions;
-        ++paths;
-      }
-  cost.lookupsPerPath = (double)total.densityLookups / paths;
-  cost.realPerPath = (double)total.realCollisions / paths;
-  return cost;
-}
-
 TEST(VeryDenseMedia, TheBounceLimitBoundsRealCollisions) {
   // Albedo 1: Russian roulette never fires (the throughput stays 1), so only
   // the bounce limit ends a path in a medium it cannot leave.
-  PathCost dense = DensePathCost(1e4f, RGB(1.f), 8);
+  failure::PathCost dense = failure::DensePathCost(1e4f, RGB(1.f), 8);
   EXPECT_EQ(dense.maxRealPerPath, 9u) << "bounce limit 8: at most 8 scatterings and the collision that ends it";
   // Albedo 0.5: Russian roulette ends most paths well before the limit.
-  PathCost absorbing = DensePathCost(1e4f, RGB(0.5f), 32);
+  failure::PathCost absorbing = failure::DensePathCost(1e4f, RGB(0.5f), 32);
   EXPECT_LE(absorbing.maxRealPerPath, 33u);
   EXPECT_LT(absorbing.realPerPath, 4.0);
 }
@@ -128,7 +91,7 @@ TEST(VeryDenseMedia, LookupsGrowNoFasterThanTheDensity) {
   // Null collisions are not bounded by the bounce limit: in a leaf that is
   // part empty, part dense, tracking takes ~majorant x empty length steps.
   // They must stay bounded by that (linear in the density), not explode.
-  PathCost d2 = DensePathCost(1e2f, RGB(0.8f), 32), d4 = DensePathCost(1e4f, RGB(0.8f), 32);
+  failure::PathCost d2 = failure::DensePathCost(1e2f, RGB(0.8f), 32), d4 = failure::DensePathCost(1e4f, RGB(0.8f), 32);
   std::printf("lookups per path: density 1e2 %.1f, 1e4 %.1f; real collisions per path %.2f, %.2f\n",
               d2.lookupsPerPath, d4.lookupsPerPath, d2.realPerPath, d4.realPerPath);
   EXPECT_LT(d4.lookupsPerPath, 100.0 * 1.1 * d2.lookupsPerPath);

@@ -68,6 +68,18 @@ struct Classifier {
 
   MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
     Classification c;
+#ifdef MMRTM_PLAIN_SCENE_ONLY
+    // The shortest path of a plain scene (one proxy, one material with one
+    // density TF, no material TFs, no additive merge), compiled only into the
+    // benchmark that measures what the general path costs such a scene
+    // (Testing/Benchmarks/mmrtm-bench-plain-scene.cpp). Never in the renderer.
+    c.proxies.v[0] = proxies[0].SampleWorld(world);
+    float v;
+    tfs[bindings[materials[0].bindingBegin].tf].Evaluate(c.proxies.v[0], &v);
+    c.sigma_t = materials[0].base[0] * v;
+    c.material = 0;
+    return c;
+#endif
     c.proxies = SampleProxies(world);
     if (additive) {
       for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
@@ -112,6 +124,9 @@ struct Classifier {
     MaterialCoefficients out;
     if (c.material == kNoMaterial) return out;
     float k[kCoefficientFloats];
+#ifdef MMRTM_PLAIN_SCENE_ONLY
+    MaterialCoefficientArray(c.material, c.proxies, k);
+#else
     if (additive) {
       // The mixture: each material's coefficients weighted by its share of sigma_t.
       for (int i = 0; i < kCoefficientFloats; ++i) k[i] = 0.f;
@@ -126,6 +141,7 @@ struct Classifier {
     } else {
       MaterialCoefficientArray(c.material, c.proxies, k);
     }
+#endif
     out.sigma_t = c.sigma_t;
     out.albedo = RGB(Clamp(k[1], 0.f, 1.f), Clamp(k[2], 0.f, 1.f), Clamp(k[3], 0.f, 1.f));
     out.roughness = Clamp(k[4], 0.f, 1.f);
