@@ -148,6 +148,39 @@ def mean_squared_z(a, b):
     return float(np.mean((a.mean - b.mean)[mask] ** 2 / var[mask]))
 
 
+def block_sums(image, block):
+    h, w, c = image.shape
+    return image[:h - h % block, :w - w % block].reshape(h // block, block, w // block, block, c).sum(axis=(1, 3))
+
+
+def block_agreement(mean_a, var_a, mean_b, var_b, block=8):
+    """Whether two independent, unbiased estimates of one image agree within noise.
+
+    On block x block pixel blocks: z = (block mean a - block mean b) /
+    sqrt(var a + var b), each block's variance summed from the per-pixel
+    variances of the means (so it is well estimated even from few samples per
+    pixel). For agreeing images the mean of z^2 over K blocks and channels is
+    1 with standard deviation sqrt(2 / K); `limit` is 1 + 5 sqrt(2 / K), a
+    one-in-a-million tail, which a bias of a fraction of the noise exceeds.
+    Blocks without noise (float rounding leaves ~1e-15 there, e.g. where only
+    the constant environment is seen) must agree to float precision.
+    """
+    n = block * block
+    a, b = block_sums(mean_a, block) / n, block_sums(mean_b, block) / n
+    var = (block_sums(var_a, block) + block_sums(var_b, block)) / n ** 2
+    noisy = var > (1e-5 * (np.abs(b) + 1e-3)) ** 2
+    silent_mismatch = int(np.sum(~noisy & (np.abs(a - b) > 1e-5 * np.abs(b) + 1e-7)))
+    z2 = (a - b)[noisy] ** 2 / var[noisy]
+    k = int(z2.size)
+    return {"mean_z2": float(z2.mean()) if k else 0.0, "terms": k, "limit": 1 + 5 * float(np.sqrt(2 / max(k, 1))),
+            "noiseless_blocks_that_differ": silent_mismatch,
+            "max_abs_block_z": float(np.sqrt(z2).max()) if k else 0.0}
+
+
+def agrees(result):
+    return result["mean_z2"] <= result["limit"] and result["noiseless_blocks_that_differ"] == 0
+
+
 def load_reference(name):
     """(mean, variance, metadata) of a reference made by make_references.py, or None."""
     mean = REFERENCE_DIR / f"{name}.pfm"
