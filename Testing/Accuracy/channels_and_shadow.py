@@ -165,8 +165,8 @@ def shadow(spp):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--part", choices=("channels", "shadow", "both"), default="both")
-    parser.add_argument("--size", type=int, default=160)
-    parser.add_argument("--converged-spp", type=int, default=2048)
+    parser.add_argument("--size", type=int, default=128)
+    parser.add_argument("--converged-spp", type=int, default=1024)
     parser.add_argument("--low-spp", type=int, default=16)
     parser.add_argument("--shadow-spp", type=int, default=256)
     args = parser.parse_args()

@@ -38,7 +38,7 @@ METHODS = [
 ]
 
 
-def measure(name, max_spp, size):
+def measure(name, max_spp, size, budget):
     ref = acc.load_reference(name)
     if ref is None:
         raise SystemExit(f"no reference for {name} in {acc.REFERENCE_DIR}: run make_references.py first")
@@ -48,6 +48,7 @@ def measure(name, max_spp, size):
     result = {"reference_spp": ref_meta["spp"], "reference_noise": acc.reference_noise(ref_mean, ref_var),
               "methods": {}}
     ladder = [s for s in (1, 2, 4, 8, 16, 32, 64, 128, 256, 512) if s <= max_spp]
+    # Every method doubles its samples up to max_spp, or until one render would exceed the time budget.
     for label, options, _, _ in METHODS:
         rows = []
         for spp in ladder:
@@ -59,6 +60,8 @@ def measure(name, max_spp, size):
                          "real_collisions": r.stats["real_collisions"]})
             print(f"  {name:13s} {label:26s} {spp:4d} spp {r.seconds:7.2f} s  rel. RMSE {rows[-1]['rel_rmse']:.4f}",
                   flush=True)
+            if r.seconds * 2 > budget:  # the next rung would take more than the budget
+                break
         result["methods"][label] = rows
     return result
 
@@ -89,7 +92,9 @@ def chart(name, result, path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--max-spp", type=int, default=128)
+    parser.add_argument("--max-spp", type=int, default=64)
+    parser.add_argument("--budget", type=float, default=30.0,
+                        help="seconds: a method's samples stop doubling before one render would take longer")
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     parser.add_argument("--charts-only", action="store_true", help="redraw from speed_accuracy.json")
     args = parser.parse_args()
@@ -97,7 +102,7 @@ def main():
     results = json.loads(store.read_text()) if store.exists() else {}
     for name in args.only or list(acc.SCENES):
         if not args.charts_only:
-            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE)
+            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE, args.budget)
             store.write_text(json.dumps(results, indent=1))
         if name in results:
             chart(name, results[name], acc.DOC_IMAGES / f"speed_accuracy_{name}.png")
