@@ -39,8 +39,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mitsuba_check as mc  # noqa: E402
 import mmrtm_accuracy as acc  # noqa: E402
 
-K = np.array([1.25, 1.0, 0.75])  # chromatic extinction: red light is stopped most (a bluish translucency)
-ALBEDO = 0.8
+K = np.array([1.2, 1.0, 0.8])  # chromatic extinction: red light is stopped most (a bluish translucency)
+ALBEDO = 0.7
 
 
 def mitsuba_medium(density, spacing, extent, cam, size, spp, seed, chromatic):

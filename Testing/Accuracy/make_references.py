@@ -7,7 +7,8 @@ For each scene of mmrtm_accuracy.SCENES: 256 x 256, delta tracking with the
 octree (the unbiased default), a fixed seed, written to MMRTM_REFERENCE_DIR
 (default build/references, not committed) as NAME.pfm (linear mean),
 NAME_variance.pfm (variance of that mean), NAME.png (to look at) and
-NAME.json (the render's statistics). The seed differs from every seed the
+NAME.json (the render's statistics), and Documentation/images/references.png
+(all five side by side). The seed differs from every seed the
 speed charts use, so a reference and a measured image are independent.
 
 The default of 2048 samples per pixel takes about half an hour on 2 cores for
@@ -17,6 +18,8 @@ by 2.8).
 
 import argparse
 import time
+
+from PIL import Image
 
 import mmrtm_accuracy as acc
 
@@ -38,6 +41,20 @@ def main():
                        extra=["--shadow-scale", "1"], keep=acc.REFERENCE_DIR / name)
         print(f"    {time.time() - start:.0f} s; relative noise {acc.reference_noise(r.mean, r.variance):.4f}, "
               f"mean {r.mean.mean():.4f} -> {acc.REFERENCE_DIR / name}.pfm", flush=True)
+    montage()
+
+
+def montage():
+    """Documentation/images/references.png: the five references side by side."""
+    images = [Image.open(acc.REFERENCE_DIR / f"{name}.png") for name in acc.SCENES
+              if (acc.REFERENCE_DIR / f"{name}.png").exists()]
+    if not images:
+        return
+    w, h = images[0].size
+    sheet = Image.new("RGB", (len(images) * (w + 4) - 4, h), (255, 255, 255))
+    for i, im in enumerate(images):
+        sheet.paste(im, (i * (w + 4), 0))
+    sheet.save(acc.DOC_IMAGES / "references.png")
 
 
 if __name__ == "__main__":

@@ -184,6 +184,31 @@ def compare(ours_mean, ours_var, mi_mean, mi_var):
     return result
 
 
+def figure(ours, mitsuba, result, path):
+    """Both images (same tone curve), their difference and the figures."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    def show(im):
+        return np.clip(im / (1 + im), 0, 1) ** (1 / 2.2)
+
+    fig, ax = plt.subplots(1, 3, figsize=(11, 4))
+    for a, (title, im) in zip(ax, [(f"mmrtm-render, {result['ours_spp']} spp, {result['ours_seconds']:.0f} s", show(ours)),
+                                   (f"Mitsuba 3 {result['mitsuba_variant']}, {result['mitsuba_spp']} spp, "
+                                    f"{result['mitsuba_seconds']:.0f} s", show(mitsuba)),
+                                   ("|difference| x 10", np.clip(10 * np.abs(ours - mitsuba), 0, 1))]):
+        a.imshow(im)
+        a.set_title(title, fontsize=9)
+        a.axis("off")
+    fig.suptitle(f"Same medium, two renderers: mean block z^2 {result['mean_z2']:.3f} (limit {result['limit']:.3f}), "
+                 f"mean ratio {result['mean_ratio']:.5f}; Mitsuba needs {result['time_to_equal_error_ratio']:.1f} x "
+                 "the time for the same error", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--ci", action="store_true", help="48 x 48, few samples: the CTest check")
@@ -192,7 +217,8 @@ def main():
     parser.add_argument("--mitsuba-spp", type=int, help="Mitsuba's samples per pixel per batch")
     parser.add_argument("--batches", type=int, default=16, help="independent Mitsuba batches (for its variance)")
     parser.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb or llvm_ad_rgb)")
-    parser.add_argument("--save", help="folder for both images (PFM and PNG) and the figures (JSON)")
+    parser.add_argument("--save", help="folder for both images and variances (PFM) and the figures (JSON); "
+                        "without --ci also draws Documentation/images/mitsuba_check.png")
     args = parser.parse_args()
     size = args.size or (48 if args.ci else 128)
     spp = args.spp or (1024 if args.ci else 2048)
@@ -233,7 +259,11 @@ def main():
         out.mkdir(parents=True, exist_ok=True)
         acc.write_pfm(out / "mmrtm.pfm", ours.mean)
         acc.write_pfm(out / "mitsuba.pfm", mi_mean)
+        acc.write_pfm(out / "mmrtm_variance.pfm", ours.variance)
+        acc.write_pfm(out / "mitsuba_variance.pfm", mi_var)
         (out / "mitsuba_check.json").write_text(json.dumps(result, indent=1))
+        if not args.ci:
+            figure(ours.mean, mi_mean, result, acc.DOC_IMAGES / "mitsuba_check.png")
     ok = acc.agrees(result) and result["mean_luminance"] > 0.01
     if biased is not None:
         sensitivity = acc.block_agreement(biased.mean, biased.variance, mi_mean, mi_var, block=4)

@@ -9,8 +9,9 @@ Runs build/bin/mmrtm-bench-plain-scene and mmrtm-bench-plain-scene-shortest
 in turn (so that both see the same machine load), N times each at 256 x 256,
 16 spp, and reports the median render times, their ratio, and whether the
 images are bit-identical. With valgrind installed it also counts the
-instructions of one small render of each (64 x 64, 2 spp), a measure that
-does not depend on the machine's load. Numbers go to
+instructions of one small render of each (64 x 64, 2 spp; the render
+workers only, not loading and set-up), a measure that does not depend on
+the machine's load. Numbers go to
 MMRTM_REFERENCE_DIR/plain_scene_overhead.json.
 """
 
@@ -34,7 +35,9 @@ def run(name, *args):
 
 def instructions(name):
     with tempfile.TemporaryDirectory() as tmp:
+        # Only the render workers (the tile loop, a lambda in CpuRenderer::Render): not loading or set-up.
         done = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={tmp}/cg.out",
+                               "--toggle-collect=*CpuRenderer::Render*lambda*",
                                str(acc.BUILD / "bin" / BENCHES[name]), "--size", "64", "--spp", "2"],
                               capture_output=True, text=True, check=True)
         match = re.search(r"Collected : (\d+)", done.stderr)

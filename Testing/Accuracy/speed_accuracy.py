@@ -9,7 +9,9 @@ Needs the references of make_references.py. Writes
 Documentation/images/speed_accuracy_NAME.png and the numbers to
 MMRTM_REFERENCE_DIR/speed_accuracy.json. The reference's own variance is
 subtracted from each squared error (mmrtm_accuracy.relative_rmse), and the
-reference's relative noise is drawn as a dotted line. Every render uses the
+reference's relative noise is drawn as a dotted line. A third panel takes the
+measured render's own variance out as well: what remains is its bias (about
+0 for the unbiased estimators, a plateau for ray marching). Every render uses the
 unbiased shadow rays (--shadow-scale 1), as the references do.
 """
 
@@ -56,6 +58,9 @@ def measure(name, max_spp, size, budget):
                            extra=["--shadow-scale", "1", *options])
             rows.append({"spp": spp, "seconds": r.seconds,
                          "rel_rmse": acc.relative_rmse(r.mean, ref_mean, ref_var),
+                         # The render's own noise taken out as well: what is left is its bias.
+                         "rel_bias": acc.relative_rmse(r.mean, ref_mean, ref_var + r.variance),
+                         "noise": acc.reference_noise(r.mean, r.variance),
                          "density_lookups": r.stats["density_lookups"],
                          "real_collisions": r.stats["real_collisions"]})
             print(f"  {name:13s} {label:26s} {spp:4d} spp {r.seconds:7.2f} s  rel. RMSE {rows[-1]['rel_rmse']:.4f}",
@@ -67,7 +72,7 @@ def measure(name, max_spp, size, budget):
 
 
 def chart(name, result, path):
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.4))
     for label, _, colour, style in METHODS:
         rows = result["methods"].get(label)
         if not rows:
@@ -76,18 +81,54 @@ def chart(name, result, path):
                        marker="o", ms=3, label=label)
         axes[1].loglog([r["spp"] for r in rows], [r["rel_rmse"] for r in rows], style, color=colour, marker="o",
                        ms=3, label=label)
-    for ax in axes:
+        # Per-pixel variances from fewer samples are too noisy to subtract reliably.
+        biased = [r for r in rows if r["spp"] >= 8]
+        axes[2].semilogx([r["spp"] for r in biased], [r["rel_bias"] for r in biased], style, color=colour,
+                         marker="o", ms=3, label=label)
+    for ax in axes[:2]:
         ax.axhline(result["reference_noise"], color="k", lw=0.8, ls=(0, (1, 3)),
                    label=f"reference's own noise ({result['reference_spp']} spp)")
-        ax.grid(True, which="both", lw=0.3)
         ax.set_ylabel("relative RMSE (reference variance subtracted)")
+    for ax in axes:
+        ax.grid(True, which="both", lw=0.3)
     axes[0].set_xlabel("render time, s (2 CPU cores)")
     axes[1].set_xlabel("samples per pixel")
+    axes[2].set_xlabel("samples per pixel")
+    axes[2].set_ylabel("relative bias (both variances subtracted)")
+    axes[2].set_ylim(bottom=0)
+    axes[2].set_xticks([8, 16, 32, 64], ["8", "16", "32", "64"])
+    axes[2].minorticks_off()
     axes[1].legend(fontsize=7, loc="lower left")
     fig.suptitle(f"{acc.SCENES[name]['title']}: error against time and samples (256 x 256)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def table(results):
+    """Markdown: per scene and method, the last measured rung, and the time each
+    method needs to reach the default's error at its last rung (t e^2 / e0^2,
+    valid while the error is still falling as 1 / sqrt(samples); a method
+    whose error has stopped falling above that error never reaches it)."""
+    lines = ["| scene | method | spp | render s | rel. RMSE | rel. bias | time to the octree's error |",
+             "|---|---|---|---|---|---|---|"]
+    for name, result in results.items():
+        target = result["methods"]["delta, octree (default)"][-1]
+        for label, _, _, _ in METHODS:
+            rows = result["methods"].get(label)
+            if not rows:
+                continue
+            last = rows[-1]
+            falling = len(rows) < 2 or last["rel_rmse"] < 0.85 * rows[-2]["rel_rmse"]
+            if last["rel_rmse"] <= target["rel_rmse"]:
+                reach = f"{last['seconds'] * (last['rel_rmse'] / target['rel_rmse']) ** 2:.1f} s"
+            elif falling:
+                reach = f"~{last['seconds'] * (last['rel_rmse'] / target['rel_rmse']) ** 2:.0f} s"
+            else:
+                reach = "never (bias)"
+            lines.append(f"| {acc.SCENES[name]['title']} | {label} | {last['spp']} | {last['seconds']:.1f} | "
+                         f"{last['rel_rmse']:.4f} | {last['rel_bias']:.4f} | {reach} |")
+    return "\n".join(lines)
 
 
 def main():
@@ -107,6 +148,7 @@ def main():
         if name in results:
             chart(name, results[name], acc.DOC_IMAGES / f"speed_accuracy_{name}.png")
             print(f"wrote {acc.DOC_IMAGES / f'speed_accuracy_{name}.png'}")
+    print(table({n: results[n] for n in (args.only or list(acc.SCENES)) if n in results}))
 
 
 if __name__ == "__main__":
