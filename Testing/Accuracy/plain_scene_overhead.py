@@ -9,9 +9,9 @@ Runs build/bin/mmrtm-bench-plain-scene and mmrtm-bench-plain-scene-shortest
 in turn (so that both see the same machine load), N times each at 256 x 256,
 16 spp, and reports the median render times, their ratio, and whether the
 images are bit-identical. With valgrind installed it also counts the
-instructions of one small render of each (64 x 64, 2 spp; the render
-workers only, not loading and set-up), a measure that does not depend on
-the machine's load. Numbers go to
+instructions of 2 spp at 64 x 64 (a 3-spp run minus a 1-spp run, so that
+loading and set-up cancel), a measure that does not depend on the
+machine's load. Numbers go to
 MMRTM_REFERENCE_DIR/plain_scene_overhead.json.
 """
 
@@ -33,15 +33,17 @@ def run(name, *args):
     return json.loads(out.stdout)
 
 
-def instructions(name):
+def total_instructions(name, spp):
     with tempfile.TemporaryDirectory() as tmp:
-        # Only the render workers (the tile loop, a lambda in CpuRenderer::Render): not loading or set-up.
         done = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={tmp}/cg.out",
-                               "--toggle-collect=*CpuRenderer::Render*lambda*",
-                               str(acc.BUILD / "bin" / BENCHES[name]), "--size", "64", "--spp", "2"],
+                               str(acc.BUILD / "bin" / BENCHES[name]), "--size", "64", "--spp", str(spp)],
                               capture_output=True, text=True, check=True)
-        match = re.search(r"Collected : (\d+)", done.stderr)
-        return int(match.group(1))
+        return int(re.search(r"Collected : (\d+)", done.stderr).group(1))
+
+
+def instructions(name):
+    # Rendering only: a 3-spp run minus a 1-spp run (loading and set-up cancel).
+    return total_instructions(name, 3) - total_instructions(name, 1)
 
 
 def main():

@@ -10,9 +10,11 @@
 namespace mmrtm {
 namespace {
 
-std::vector<float> Render(Scene& scene, int threads, uint64_t seed, int passes) {
+// `forceGeneral`: classify as if the scene were not plain (Classifier::plain off).
+std::vector<float> Render(Scene& scene, int threads, uint64_t seed, int passes, bool forceGeneral = false) {
   scene.render.integrator.seed = seed;
   SceneView view = scene.Build();
+  if (forceGeneral) view.classifier.plain = false;
   Film film(37, 23);  // not a multiple of the tile size
   for (int p = 0; p < passes; ++p) CpuRenderer(threads).Render(view, film, 8 / passes);
   std::vector<float> pixels;
@@ -48,6 +50,30 @@ TEST(Determinism, ThreadCountDoesNotChangeTheImage) {
   double sum = 0;
   for (float v : one) sum += v;
   EXPECT_GT(sum, 0.0) << "a black image proves nothing";
+}
+
+TEST(Determinism, PlainScenePathEqualsTheGeneralPath) {
+  // A plain scene (one proxy, one material, one density TF) takes the
+  // classifier's shortest path; it must compute exactly what the general
+  // path computes.
+  Scene scene = MakeScene();
+  ASSERT_TRUE(scene.Build().classifier.plain);
+  std::vector<float> shortest = Render(scene, 2, 9, 1), general = Render(scene, 2, 9, 1, true);
+  EXPECT_EQ(0, std::memcmp(shortest.data(), general.data(), shortest.size() * sizeof(float)));
+  // A second material TF-selected makes it not plain.
+  Scene labelled = MakeScene();
+  labelled.proxies.push_back(test::MakeVolume(12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
+  labelled.materials.push_back(labelled.materials[0]);
+  labelled.materials[1].name = "other";
+  TransferFunctionDesc selector;
+  selector.where = "test";
+  selector.type = TFType::MDPTF;
+  selector.proxy = 1;
+  selector.keys = {1.f};
+  selector.materials = {1};
+  labelled.tfs.push_back(selector);
+  labelled.selectors.push_back((int)labelled.tfs.size() - 1);
+  EXPECT_FALSE(labelled.Build().classifier.plain);
 }
 
 TEST(Determinism, ProgressivePassesEqualOneRender) {

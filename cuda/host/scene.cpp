@@ -250,6 +250,8 @@ SceneView Scene::Build() {
 
   c.tfCount = (int)tfViews_.size();
   c.materialCount = (int)materialViews_.size();
+  c.plain = c.proxyCount == 1 && c.materialCount == 1 && c.selectorCount == 0 && !c.additive &&
+            c.defaultMaterial == 0 && materialViews_[0].densityBindingCount == 1;
 
   // Majorants: the global bound always (it is cheap), the grid when asked
   // for. The grid's summaries depend only on the voxels; a TF change refits.

@@ -46,6 +46,11 @@ struct Classifier {
   // weighted by extinction (the collision's particle is of material m with
   // probability sigma_m / sigma_t). Material TFs and the default are unused.
   bool additive = false;
+  // A plain scene: one proxy, one material (the default) with one density
+  // TF, no material TFs, not additive. Classify then takes its shortest path
+  // (one lookup, one TF), so that the multi-material machinery costs such a
+  // scene nothing (DESIGN.md rule 3; Documentation/performance.md).
+  bool plain = false;
 
   MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world) const {
     ProxySamples s;
@@ -69,17 +74,20 @@ struct Classifier {
   MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
     Classification c;
 #ifdef MMRTM_PLAIN_SCENE_ONLY
-    // The shortest path of a plain scene (one proxy, one material with one
-    // density TF, no material TFs, no additive merge), compiled only into the
-    // benchmark that measures what the general path costs such a scene
-    // (Testing/Benchmarks/mmrtm-bench-plain-scene.cpp). Never in the renderer.
-    c.proxies.v[0] = proxies[0].SampleWorld(world);
-    float v;
-    tfs[bindings[materials[0].bindingBegin].tf].Evaluate(c.proxies.v[0], &v);
-    c.sigma_t = materials[0].base[0] * v;
-    c.material = 0;
-    return c;
+    // Compiled only into the benchmark that measures what the general path
+    // costs a plain scene (Testing/Benchmarks/mmrtm-bench-plain-scene.cpp).
+    constexpr bool shortest = true;
+#else
+    const bool shortest = plain;
 #endif
+    if (shortest) {
+      c.proxies.v[0] = proxies[0].SampleWorld(world);
+      float v;
+      tfs[bindings[materials[0].bindingBegin].tf].Evaluate(c.proxies.v[0], &v);
+      c.sigma_t = materials[0].base[0] * v;
+      c.material = 0;
+      return c;
+    }
     c.proxies = SampleProxies(world);
     if (additive) {
       for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
@@ -124,9 +132,6 @@ struct Classifier {
     MaterialCoefficients out;
     if (c.material == kNoMaterial) return out;
     float k[kCoefficientFloats];
-#ifdef MMRTM_PLAIN_SCENE_ONLY
-    MaterialCoefficientArray(c.material, c.proxies, k);
-#else
     if (additive) {
       // The mixture: each material's coefficients weighted by its share of sigma_t.
       for (int i = 0; i < kCoefficientFloats; ++i) k[i] = 0.f;
@@ -141,7 +146,6 @@ struct Classifier {
     } else {
       MaterialCoefficientArray(c.material, c.proxies, k);
     }
-#endif
     out.sigma_t = c.sigma_t;
     out.albedo = RGB(Clamp(k[1], 0.f, 1.f), Clamp(k[2], 0.f, 1.f), Clamp(k[3], 0.f, 1.f));
     out.roughness = Clamp(k[4], 0.f, 1.f);
