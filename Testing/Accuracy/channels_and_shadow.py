@@ -25,7 +25,6 @@ numbers to MMRTM_REFERENCE_DIR/channels.json and shadow_scale.json.
 import argparse
 import json
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -45,11 +44,6 @@ ALBEDO = 0.7
 
 def mitsuba_medium(density, spacing, extent, cam, size, spp, seed, config):
     import mitsuba as mi
-    mi.set_variant("scalar_rgb")
-    T = mi.ScalarTransform4f
-    half_voxel = np.array(spacing) / 2
-    grid = {"to_world": T().translate((-half_voxel).tolist()).scale((extent + 2 * half_voxel).tolist()),
-            "filter_type": "trilinear"}
     kmean = K.mean()
     if config == "rgb_extinction":
         sigma = density[..., None] * K[None, None, None, :]
@@ -62,23 +56,7 @@ def mitsuba_medium(density, spacing, extent, cam, size, spp, seed, config):
         # the albedo that keeps each channel's scattering coefficient, a k_c / k_mean.
         a = np.full(3, ALBEDO) if config == "same_albedo" else np.minimum(1.0, ALBEDO * K / kmean)
         albedo = np.broadcast_to(a, density.shape + (3,)).copy()
-    scene = mi.load_dict({
-        "type": "scene",
-        "integrator": {"type": "volpath", "max_depth": mc.MAX_BOUNCES + 1, "rr_depth": 5},
-        "sensor": {"type": "perspective", "fov": cam["fov"], "fov_axis": "y",
-                   "to_world": T().look_at(origin=cam["position"], target=cam["look_at"], up=cam["up"]),
-                   "sampler": {"type": "independent", "sample_count": spp},
-                   "film": {"type": "hdrfilm", "width": size, "height": size, "rfilter": {"type": "box"}}},
-        "environment": {"type": "constant", "radiance": {"type": "rgb", "value": list(mc.ENVIRONMENT)}},
-        "sun": {"type": "directional", "direction": list(mc.SUN_DIRECTION),
-                "irradiance": {"type": "rgb", "value": list(mc.SUN_IRRADIANCE)}},
-        "medium_box": {
-            "type": "cube", "to_world": T().translate((extent / 2).tolist()).scale((extent / 2).tolist()),
-            "bsdf": {"type": "null"},
-            "interior": {"type": "heterogeneous", "scale": float(scale), "phase": {"type": "hg", "g": mc.G},
-                         "sigma_t": {"type": "gridvolume", "grid": mi.VolumeGrid(sigma.astype(np.float32)), **grid},
-                         "albedo": {"type": "gridvolume", "grid": mi.VolumeGrid(albedo.astype(np.float32)), **grid}}},
-    })
+    scene = mc.mitsuba_scene("scalar_rgb", sigma, albedo, scale, spacing, extent, cam, size, spp)
     return np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)[..., :3]
 
 

@@ -38,7 +38,6 @@ time x noise^2 (both are unbiased, so the error is the noise).
 import argparse
 import json
 import math
-import subprocess
 import sys
 import tempfile
 import time
@@ -132,18 +131,18 @@ def render_ours(folder, cam, size, spp, seed, shadow_scale=1.0):
     return acc.render(["--scene", path], size, size, spp, seed=seed)
 
 
-def render_mitsuba(variant, density, albedo_t, spacing, extent, cam, size, spp, batches):
+def mitsuba_scene(variant, sigma_t, albedo, scale, spacing, extent, cam, size, spp):
+    """The check's scene in Mitsuba 3: grids (z, y, x, channels) of extinction
+    (times `scale`) and albedo in a null-BSDF cube, the lights and camera."""
     import mitsuba as mi
     mi.set_variant(variant)
     T = mi.ScalarTransform4f
-    nz, ny, nx = density.shape
-    albedo = (np.array(ALBEDO_LOW) + albedo_t[..., None] * (np.array(ALBEDO_HIGH) - np.array(ALBEDO_LOW)))
     # A gridvolume puts voxel i's value at (i + 0.5) / n of its unit cube, so
     # the cube is widened by half a voxel to put voxel centres where ours are.
     half_voxel = np.array(spacing) / 2
     volume_to_world = T().translate((-half_voxel).tolist()).scale((extent + 2 * half_voxel).tolist())
     grid = {"to_world": volume_to_world, "filter_type": "trilinear"}
-    scene = mi.load_dict({
+    return mi.load_dict({
         "type": "scene",
         "integrator": {"type": "volpath", "max_depth": MAX_BOUNCES + 1, "rr_depth": 5},
         "sensor": {"type": "perspective", "fov": cam["fov"], "fov_axis": "y",
@@ -157,11 +156,16 @@ def render_mitsuba(variant, density, albedo_t, spacing, extent, cam, size, spp, 
         "medium_box": {
             "type": "cube", "to_world": T().translate((extent / 2).tolist()).scale((extent / 2).tolist()),
             "bsdf": {"type": "null"},
-            "interior": {"type": "heterogeneous", "scale": SIGMA_MAX, "phase": {"type": "hg", "g": G},
-                         "sigma_t": {"type": "gridvolume", "grid": mi.VolumeGrid(density[..., None].astype(np.float32)),
-                                     **grid},
+            "interior": {"type": "heterogeneous", "scale": float(scale), "phase": {"type": "hg", "g": G},
+                         "sigma_t": {"type": "gridvolume", "grid": mi.VolumeGrid(sigma_t.astype(np.float32)), **grid},
                          "albedo": {"type": "gridvolume", "grid": mi.VolumeGrid(albedo.astype(np.float32)), **grid}}},
     })
+
+
+def render_mitsuba(variant, density, albedo_t, spacing, extent, cam, size, spp, batches):
+    import mitsuba as mi
+    albedo = (np.array(ALBEDO_LOW) + albedo_t[..., None] * (np.array(ALBEDO_HIGH) - np.array(ALBEDO_LOW)))
+    scene = mitsuba_scene(variant, density[..., None], albedo, SIGMA_MAX, spacing, extent, cam, size, spp)
     images, seconds = [], 0.0
     for b in range(batches):
         start = time.time()
