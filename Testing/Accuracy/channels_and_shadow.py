@@ -128,7 +128,7 @@ def shadow(spp):
                            extra=["--shadow-scale", str(scale)])
             row[str(scale)] = {"rel_rmse": acc.relative_rmse(r.mean, ref_mean, ref_var),
                                "mean_ratio": float(r.mean.mean() / ref_mean.mean()),
-                               "noise": acc.reference_noise(r.mean, r.variance), "seconds": r.seconds}
+                               "noise": acc.relative_noise(r.mean, r.variance), "seconds": r.seconds}
         out[name] = row
         print(f"{name:13s} scale 0.8: mean x{row['0.8']['mean_ratio']:.3f}, rel. RMSE {row['0.8']['rel_rmse']:.4f}; "
               f"scale 1: mean x{row['1.0']['mean_ratio']:.3f}, rel. RMSE {row['1.0']['rel_rmse']:.4f} "

@@ -39,7 +39,7 @@ def main():
         print(f"[{i + 1}/{len(names)}] {name}: {args.size}^2, {args.spp} spp ...", flush=True)
         r = acc.render(acc.SCENES[name]["args"], args.size, args.size, args.spp, seed=REFERENCE_SEED,
                        extra=["--shadow-scale", "1"], keep=acc.REFERENCE_DIR / name)
-        print(f"    {time.time() - start:.0f} s; relative noise {acc.reference_noise(r.mean, r.variance):.4f}, "
+        print(f"    {time.time() - start:.0f} s; relative noise {acc.relative_noise(r.mean, r.variance):.4f}, "
               f"mean {r.mean.mean():.4f} -> {acc.REFERENCE_DIR / name}.pfm", flush=True)
     montage()
 

@@ -18,10 +18,10 @@ import mmrtm_accuracy as acc
 DATASETS = [
     # name, mmrtm-render arguments
     *[(name, scene["args"]) for name, scene in acc.SCENES.items()],
-    ("ct_head_headsq (small CT)", [acc._data("ct_head_headsq.nrrd"), "--preset", "ct-bone"]),
-    ("ct_abdomen + 31 labels (ct-organs)", [acc._data("ct_abdomen.nii.gz"), "--labels",
-                                            acc._data("ct_abdomen_labels.nii.gz"), "--label-table",
-                                            acc._data("ct_abdomen_labels.txt"), "--preset", "ct-organs"]),
+    ("ct_head_headsq (small CT)", [acc.data_path("ct_head_headsq.nrrd"), "--preset", "ct-bone"]),
+    ("ct_abdomen + 31 labels (ct-organs)", [acc.data_path("ct_abdomen.nii.gz"), "--labels",
+                                            acc.data_path("ct_abdomen_labels.nii.gz"), "--label-table",
+                                            acc.data_path("ct_abdomen_labels.txt"), "--preset", "ct-organs"]),
 ]
 
 

@@ -249,8 +249,8 @@ def main():
                                                  mi_spp, args.batches)
     print(f"Mitsuba {args.variant}: {size}^2, {args.batches} x {mi_spp} spp, {mi_seconds:.2f} s render")
     result = compare(ours.mean, ours.variance, mi_mean, mi_var)
-    ours_noise = acc.reference_noise(ours.mean, ours.variance)
-    mi_noise = acc.reference_noise(mi_mean, mi_var)
+    ours_noise = acc.relative_noise(ours.mean, ours.variance)
+    mi_noise = acc.relative_noise(mi_mean, mi_var)
     # Time to reach a given relative noise e: t * (noise / e)^2; the ratio does not depend on e.
     result.update({"size": size, "ours_spp": spp, "ours_seconds": ours_seconds, "ours_noise": ours_noise,
                    "mitsuba_variant": args.variant, "mitsuba_spp": mi_spp * args.batches,

@@ -27,7 +27,7 @@ RENDER = BUILD / "bin" / "mmrtm-render"
 DOC_IMAGES = ROOT / "Documentation" / "images"
 
 
-def _data(name):
+def data_path(name):
     return str(DATA / name)
 
 
@@ -36,24 +36,24 @@ def _data(name):
 SCENES = {
     "head_ct_bone": {
         "title": "head CT, ct-bone",
-        "args": [_data("ct_head_cranium.nrrd"), "--preset", "ct-bone"],
+        "args": [data_path("ct_head_cranium.nrrd"), "--preset", "ct-bone"],
     },
     "chest_ct": {
         "title": "chest CT (DICOM), ct-soft-tissue",
-        "args": [_data("ct_chest_dicom"), "--preset", "ct-soft-tissue"],
+        "args": [data_path("ct_chest_dicom"), "--preset", "ct-soft-tissue"],
     },
     "cta_labels": {
         "title": "chest CTA, vessel labels as materials",
-        "args": [_data("cta_chest_aorta.nii.gz"), "--labels", _data("cta_chest_aorta_labels.nii.gz"),
+        "args": [data_path("cta_chest_aorta.nii.gz"), "--labels", data_path("cta_chest_aorta_labels.nii.gz"),
                  "--preset", "ct-angio-labels"],
     },
     "bonsai": {
         "title": "bonsai",
-        "args": [_data("bonsai.nii.gz"), "--scene", str(ROOT / "Data" / "benchmarks" / "bonsai.json")],
+        "args": [data_path("bonsai.nii.gz"), "--scene", str(ROOT / "Data" / "benchmarks" / "bonsai.json")],
     },
     "mri_labels": {
         "title": "MRI head, brain and skull labels",
-        "args": [_data("mr_head.nii.gz"), "--labels", _data("mr_head_labels.nii.gz"),
+        "args": [data_path("mr_head.nii.gz"), "--labels", data_path("mr_head_labels.nii.gz"),
                  "--scene", str(ROOT / "Data" / "benchmarks" / "mr_head_labels.json")],
     },
 }
@@ -133,19 +133,10 @@ def relative_rmse(image, reference, reference_variance=None):
     return float(np.sqrt(squared) / np.mean(reference))
 
 
-def reference_noise(reference, reference_variance):
-    """The reference's own relative RMS noise (same scale as relative_rmse)."""
-    return float(np.sqrt(np.mean(reference_variance)) / np.mean(reference))
-
-
-def mean_squared_z(a, b):
-    """Mean over pixels and channels of (a - b)^2 / (var_a + var_b), pixels with variance only.
-
-    About 1 when two independent renders estimate the same image, well above 1
-    when they differ. Arguments are Render objects."""
-    var = a.variance + b.variance
-    mask = var > 0
-    return float(np.mean((a.mean - b.mean)[mask] ** 2 / var[mask]))
+def relative_noise(image, variance):
+    """An image's relative RMS noise from the variance of its per-pixel means
+    (same scale as relative_rmse)."""
+    return float(np.sqrt(np.mean(variance)) / np.mean(image))
 
 
 def block_sums(image, block):
@@ -153,7 +144,7 @@ def block_sums(image, block):
     return image[:h - h % block, :w - w % block].reshape(h // block, block, w // block, block, c).sum(axis=(1, 3))
 
 
-def block_agreement(mean_a, var_a, mean_b, var_b, block=8):
+def block_agreement(mean_a, var_a, mean_b, var_b, block=4):
     """Whether two independent, unbiased estimates of one image agree within noise.
 
     On block x block pixel blocks: z = (block mean a - block mean b) /

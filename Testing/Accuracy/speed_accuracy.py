@@ -47,7 +47,7 @@ def measure(name, max_spp, size, budget):
     ref_mean, ref_var, ref_meta = ref
     if ref_mean.shape[0] != size:
         raise SystemExit(f"reference {name} is {ref_mean.shape[1]}x{ref_mean.shape[0]}, not {size}^2")
-    result = {"reference_spp": ref_meta["spp"], "reference_noise": acc.reference_noise(ref_mean, ref_var),
+    result = {"reference_spp": ref_meta["spp"], "reference_noise": acc.relative_noise(ref_mean, ref_var),
               "methods": {}}
     ladder = [s for s in (1, 2, 4, 8, 16, 32, 64, 128, 256, 512) if s <= max_spp]
     # Every method doubles its samples up to max_spp, or until one render would exceed the time budget.
@@ -60,7 +60,7 @@ def measure(name, max_spp, size, budget):
                          "rel_rmse": acc.relative_rmse(r.mean, ref_mean, ref_var),
                          # The render's own noise taken out as well: what is left is its bias.
                          "rel_bias": acc.relative_rmse(r.mean, ref_mean, ref_var + r.variance),
-                         "noise": acc.reference_noise(r.mean, r.variance),
+                         "noise": acc.relative_noise(r.mean, r.variance),
                          "density_lookups": r.stats["density_lookups"],
                          "real_collisions": r.stats["real_collisions"]})
             print(f"  {name:13s} {label:26s} {spp:4d} spp {r.seconds:7.2f} s  rel. RMSE {rows[-1]['rel_rmse']:.4f}",

@@ -23,10 +23,7 @@ json Row(const Estimate& e, double exact) {
           {"violations", e.violations}};
 }
 
-Estimate Measure(failure::Case& c, Method m, int trials) {
-  SceneView s = c.scene.Build();
-  return failure::Transmittance(s, c.ray, m, trials, 1);
-}
+using failure::Measure;
 
 const char* Name(MajorantKind k) {
   return k == MajorantKind::Global ? "none" : k == MajorantKind::Macrocell ? "macrocell" : "octree";
@@ -93,15 +90,9 @@ json Grazing() {
 json Degenerate() {
   json out = json::object();
   for (MajorantKind k : {MajorantKind::Global, MajorantKind::Macrocell, MajorantKind::Octree}) {
-    failure::Case zero{failure::SceneWithTF(test::MakeConstantVolume(16, 100.f),
-                                            failure::CCTF({0.f, 1000.f}, {0.f, 0.f}), 1.f, k),
-                       Ray{{-2.f, 7.3f, 7.6f}, {1.f, 0.f, 0.f}}, 1.0};
+    failure::Case zero = failure::AllZeroTF(k);
     out["all_zero"][Name(k)] = Row(Measure(zero, Method::RatioTracking, 20000), zero.exact);
-    failure::Case one{failure::SceneWithTF(test::MakeVolume(17, 17, 17, [](int i, int j, int kk) {
-                                             return float((i * 31 + j * 17 + kk * 7) % 100);
-                                           }),
-                                           failure::CCTF({0.f, 99.f}, {1.f, 1.f}), 0.1f, k),
-                      Ray{{-2.f, 8.3f, 8.6f}, {1.f, 0.f, 0.f}}, std::exp(-0.1 * 16.0)};
+    failure::Case one = failure::AllOneTF(k);
     out["all_one"][Name(k)] = Row(Measure(one, Method::RatioTracking, 20000), one.exact);
     failure::Case step = failure::SaturatedBlock(0.4f, k);
     out["step_at_maximum"][Name(k)] = Row(Measure(step, Method::RatioTracking, 20000), step.exact);

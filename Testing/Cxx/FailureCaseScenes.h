@@ -14,6 +14,8 @@
 //     on a face between majorant-grid nodes.
 //   - SaturatedBlock: a TF step at the data maximum (a saturated block of
 //     voxels), the top edge of the value bins.
+//   - AllZeroTF, AllOneTF: the other degenerate TFs.
+//   - DensePathCost: whole paths in very dense media (counts, not a bias).
 #pragma once
 
 #include <algorithm>
@@ -83,6 +85,12 @@ struct Case {
   Ray ray;
   double exact;
 };
+
+// `trials` estimates of the case's transmittance (seed 1).
+inline Estimate Measure(Case& c, Method method, int trials = 100000) {
+  SceneView s = c.scene.Build();
+  return Transmittance(s, c.ray, method, trials, 1);
+}
 
 // Values rise by 1 per voxel along x (0 .. 20, 1 mm voxels); a triangular TF
 // peak of half-width `halfWidth` at 10.5 (between two voxel values), density
@@ -156,6 +164,20 @@ inline Case SaturatedBlock(float density, MajorantKind kind) {
                      CCTF({254.999f, 255.f}, {0.f, 1.f}), density, kind),
          Ray{{-1.f, 15.f, 16.f}, {1.f, 0.f, 0.f}}, std::exp(-3.0 * density)};
   return c;
+}
+
+// Degenerate TFs over a 16^3 (all zero) or 17^3 (all one, over noisy data)
+// volume, 1 mm voxels, ray along x: T = 1, and Beer-Lambert over 16 mm at
+// extinction 0.1.
+inline Case AllZeroTF(MajorantKind kind) {
+  return {SceneWithTF(test::MakeConstantVolume(16, 100.f), CCTF({0.f, 1000.f}, {0.f, 0.f}), 1.f, kind),
+          Ray{{-2.f, 7.3f, 7.6f}, {1.f, 0.f, 0.f}}, 1.0};
+}
+
+inline Case AllOneTF(MajorantKind kind) {
+  return {SceneWithTF(test::MakeVolume(17, 17, 17, [](int i, int j, int k) { return float((i * 31 + j * 17 + k * 7) % 100); }),
+                      CCTF({0.f, 99.f}, {1.f, 1.f}), 0.1f, kind),
+          Ray{{-2.f, 8.3f, 8.6f}, {1.f, 0.f, 0.f}}, std::exp(-0.1 * 16.0)};
 }
 
 // --- Very dense media: the cost of whole paths ---

@@ -60,7 +60,7 @@ TEST(Determinism, PlainScenePathEqualsTheGeneralPath) {
   ASSERT_TRUE(scene.Build().classifier.plain);
   std::vector<float> shortest = Render(scene, 2, 9, 1), general = Render(scene, 2, 9, 1, true);
   EXPECT_EQ(0, std::memcmp(shortest.data(), general.data(), shortest.size() * sizeof(float)));
-  // A second material TF-selected makes it not plain.
+  // A second material, chosen by an MDPTF over a label proxy, makes it not plain.
   Scene labelled = MakeScene();
   labelled.proxies.push_back(test::MakeVolume(12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
   labelled.materials.push_back(labelled.materials[0]);

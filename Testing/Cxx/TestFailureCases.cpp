@@ -17,15 +17,10 @@ namespace mmrtm {
 namespace {
 
 using failure::Estimate;
+using failure::Measure;  // 100000 trials unless told
 using failure::Method;
 
-constexpr int kTrials = 100000;
 constexpr double kSigmas = 4.0;
-
-Estimate Measure(failure::Case& c, Method m, int trials = kTrials) {
-  SceneView s = c.scene.Build();
-  return failure::Transmittance(s, c.ray, m, trials, 1);
-}
 
 // --- A narrow TF peak -------------------------------------------------------
 
@@ -126,7 +121,7 @@ TEST(GrazingRays, TippedAcrossTheSheet) {
 
 // --- Degenerate TFs ---------------------------------------------------------
 
-Film RenderAbsorbing(Scene& scene, TraceCounters* ctr) {
+Film RenderUnderConstantSky(Scene& scene, TraceCounters* ctr) {
   scene.environment = EnvironmentMap::Constant(RGB(0.3f, 0.4f, 0.5f));
   scene.render.width = scene.render.height = 24;
   SceneView view = scene.Build();
@@ -136,10 +131,9 @@ Film RenderAbsorbing(Scene& scene, TraceCounters* ctr) {
 }
 
 TEST(DegenerateTF, AllZeroShowsTheEnvironmentWithoutALookup) {
-  Scene scene = failure::SceneWithTF(test::MakeConstantVolume(16, 100.f), failure::CCTF({0.f, 1000.f}, {0.f, 0.f}),
-                                     1.f, MajorantKind::Octree);
+  failure::Case c = failure::AllZeroTF(MajorantKind::Octree);
   TraceCounters ctr;
-  Film film = RenderAbsorbing(scene, &ctr);
+  Film film = RenderUnderConstantSky(c.scene, &ctr);
   EXPECT_EQ(ctr.densityLookups, 0u) << "an empty grid needs no lookup";
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 24; ++x) {
@@ -152,9 +146,7 @@ TEST(DegenerateTF, AllZeroShowsTheEnvironmentWithoutALookup) {
 TEST(DegenerateTF, AllOneIsAHomogeneousBox) {
   // A constant TF of 1 over noisy data: Beer-Lambert through the box.
   for (MajorantKind kind : {MajorantKind::Global, MajorantKind::Octree}) {
-    failure::Case c{failure::SceneWithTF(test::MakeVolume(17, 17, 17, [](int i, int j, int k) { return float((i * 31 + j * 17 + k * 7) % 100); }),
-                                         failure::CCTF({0.f, 99.f}, {1.f, 1.f}), 0.1f, kind),
-                    Ray{{-2.f, 8.3f, 8.6f}, {1.f, 0.f, 0.f}}, std::exp(-0.1 * 16.0)};
+    failure::Case c = failure::AllOneTF(kind);
     for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
       Estimate e = Measure(c, m);
       EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError) << "kind " << (int)kind;
