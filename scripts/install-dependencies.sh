@@ -9,6 +9,7 @@ packages=(
   libinsighttoolkit5-dev   # DICOM through ITK + GDCM (JPEG 2000 included)
   python3-dev              # the Python wrapping of the VTK module
   xvfb xauth
+  ninja-build              # the VTK 9.6 SDK and the wheel build (scripts/make-vtk-sdk.sh)
   python3-venv             # .venv: Mitsuba 3, numpy, matplotlib (accuracy checks and charts)
   invesalius-examples   # the default input: Cranium.inv3
 )
@@ -36,3 +37,18 @@ if ! "$venv/bin/python" -c "import mitsuba, numpy, matplotlib" 2>/dev/null; then
   "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
     -r "$here/Testing/Accuracy/requirements.txt"
 fi
+
+# The VTK 9.6 flavour (Documentation/vtk-flavours.md): a venv of Debian's
+# Python with the PyPI VTK and the Slicer core that runs on it, and the tools
+# that build the mmrtm wheel (pinned in Testing/Python/requirements-vtk96.txt);
+# then the VTK 9.6 SDK that the wheel builds against (once; it is cached).
+venv96="$here/.venv-vtk96"
+requirements96="$here/Testing/Python/requirements-vtk96.txt"
+if ! "$venv96/bin/python" -m pip install --dry-run --no-index --disable-pip-version-check --quiet \
+       -r "$requirements96" >/dev/null 2>&1; then
+  echo "Setting up $venv96 ($(grep -c '^[a-z]' "$requirements96") pinned packages: vtk 9.6, the Slicer core, build tools)" >&2
+  [ -x "$venv96/bin/python" ] || /usr/bin/python3 -m venv "$venv96"
+  "$venv96/bin/python" -m pip install --quiet --disable-pip-version-check -r "$requirements96"
+fi
+"$here/scripts/make-vtk-sdk.sh" --python "$venv96/bin/python" \
+  --cmake "$venv96/bin/cmake" --ninja "$venv96/bin/ninja" >/dev/null

@@ -22,6 +22,8 @@ from vtkmodules.vtkRenderingCore import (vtkActor, vtkTexture, vtkPolyDataMapper
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
 
+from vtkmodules.util.vtkConstants import VTK_STRING
+
 from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
@@ -82,6 +84,18 @@ class Scene:
         a = grab.GetOutput().GetPointData().GetScalars()
         n = a.GetNumberOfComponents()
         return [a.GetValue(i) for i in range(a.GetNumberOfTuples() * n) if i % n < 3]
+
+
+class ErrorCatcher:
+    """Collects the messages of an object's ErrorEvent (instead of printing them)."""
+
+    CallDataType = VTK_STRING  # VTK passes the message to __call__
+
+    def __init__(self):
+        self.messages = []
+
+    def __call__(self, obj, event, message):
+        self.messages.append(message)
 
 
 def mean_abs_difference(a, b):
@@ -411,6 +425,8 @@ class MapperTest(unittest.TestCase):
 
 
 class ReaderTest(unittest.TestCase):
+    @unittest.skipUnless(vtkMultiMaterialVolumeReader.CanReadCompressedDICOM(),
+                         "this build reads uncompressed DICOM only (no ITK: the PyPI VTK wheel's flavour)")
     def test_reads_a_jpeg2000_dicom_series_in_hounsfield_units(self):
         reader = vtkMultiMaterialVolumeReader()
         reader.SetFileName(os.path.join(DATA, "ct_abdomen_dicom_j2k"))
@@ -422,6 +438,17 @@ class ReaderTest(unittest.TestCase):
         self.assertLessEqual(low, -1000)  # air in Hounsfield units
         self.assertGreater(high, 500)
         self.assertEqual(reader.GetWarnings(), "")
+
+    @unittest.skipIf(vtkMultiMaterialVolumeReader.CanReadCompressedDICOM(),
+                     "this build decodes compressed DICOM (ITK/GDCM)")
+    def test_compressed_dicom_without_itk_is_a_clear_error(self):
+        reader = vtkMultiMaterialVolumeReader()
+        reader.SetFileName(os.path.join(DATA, "ct_abdomen_dicom_j2k"))
+        errors = ErrorCatcher()
+        reader.AddObserver("ErrorEvent", errors)
+        reader.Update()
+        self.assertEqual(reader.GetOutput().GetNumberOfPoints(), 0)
+        self.assertTrue(any("JPEG 2000" in m and "ct_abdomen_dicom_j2k" in m for m in errors.messages), errors.messages)
 
     def test_a_missing_file_is_an_error_not_a_crash(self):
         reader = vtkMultiMaterialVolumeReader()

@@ -96,7 +96,7 @@ int CheckDicomTransferSyntaxes(const std::string& folder, const std::vector<std:
     if (!IsUncompressedTransferSyntax(uid))
       throw InputError(folder + ": " + fs::path(file).filename().string() + " is " + DescribeTransferSyntax(uid) +
                        " DICOM (transfer syntax " + uid +
-                       "); it needs the ITK/GDCM reader, which is not built (MMRTM_ENABLE_ITK)");
+                       "); it needs the ITK/GDCM reader, which this build lacks (MMRTM_ENABLE_ITK is off, as in the pip wheel)");
   }
   return part10;
 }
@@ -197,7 +197,7 @@ Vec3d DicomSliceStep(const std::string& folder, const std::vector<DicomSliceHead
 
 void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoadOptions& options) {
   if (!options.series.empty())
-    throw InputError(folder + ": choosing a series needs the ITK/GDCM reader, which is not built (MMRTM_ENABLE_ITK)");
+    throw InputError(folder + ": choosing a series needs the ITK/GDCM reader, which this build lacks (MMRTM_ENABLE_ITK is off, as in the pip wheel)");
   const std::vector<std::string> files = ListFiles(folder);
   if (files.empty())
     throw InputError(folder + ": the folder holds no files (expected the DICOM files of one series)");
@@ -254,8 +254,10 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoa
   out.indexToWorld = IndexToWorld(origin, {dx, dy, dz}, direction);
 }
 
+bool DicomDecodesCompressedSyntaxes() { return false; }
+
 std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder) {
-  throw InputError(folder + ": listing DICOM series needs the ITK/GDCM reader, which is not built (MMRTM_ENABLE_ITK)");
+  throw InputError(folder + ": listing DICOM series needs the ITK/GDCM reader, which this build lacks (MMRTM_ENABLE_ITK is off, as in the pip wheel)");
 }
 
 }  // namespace mmrtm

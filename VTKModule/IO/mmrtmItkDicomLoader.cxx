@@ -288,6 +288,8 @@ std::vector<float> ResampleSlices(const std::vector<float>& voxels, int64_t slic
 
 }  // namespace
 
+bool DicomDecodesCompressedSyntaxes() { return true; }
+
 std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder) {
   gdcm::Trace::WarningOff();
   std::vector<DicomSeriesSummary> list;

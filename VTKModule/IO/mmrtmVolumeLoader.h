@@ -68,6 +68,11 @@ struct DicomSeriesSummary {
 // for a missing folder or one with no DICOM image file.
 std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder);
 
+// Whether DICOM folders are read through ITK/GDCM (compressed transfer
+// syntaxes such as JPEG 2000 included) rather than vtkDICOMImageReader
+// (uncompressed only).
+bool DicomDecodesCompressedSyntaxes();
+
 // The default input: InVesalius's Cranium.inv3 from Debian's
 // invesalius-examples package.
 std::string DefaultVolumePath();

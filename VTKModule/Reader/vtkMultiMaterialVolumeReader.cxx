@@ -136,6 +136,11 @@ int vtkMultiMaterialVolumeReader::RequestData(
   return 1;
 }
 
+bool vtkMultiMaterialVolumeReader::CanReadCompressedDICOM()
+{
+  return mmrtm::DicomDecodesCompressedSyntaxes();
+}
+
 void vtkMultiMaterialVolumeReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);

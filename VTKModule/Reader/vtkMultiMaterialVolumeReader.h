@@ -6,7 +6,8 @@
  * as a VTK reader: NRRD, NIfTI, MetaImage, VTK image data, InVesalius
  * projects, and DICOM folders through ITK/GDCM (any transfer syntax GDCM
  * decodes, the series chosen by UID or description, rescaled to Hounsfield
- * units, gantry tilt kept as a shear, uneven spacing resampled). The output
+ * units, gantry tilt kept as a shear, uneven spacing resampled; builds
+ * without ITK read uncompressed DICOM only, see CanReadCompressedDICOM). The output
  * vtkImageData carries the world geometry (LPS millimetres) as origin,
  * spacing and direction matrix, so vtkMultiMaterialVolumeMapper places it
  * as the file says. Errors (a missing file, a damaged series) are reported
@@ -49,6 +50,14 @@ public:
    * one per line; empty when there were none.
    */
   const char* GetWarnings() { return this->Warnings.c_str(); }
+
+  /**
+   * Whether this build reads compressed DICOM (JPEG 2000 and the other
+   * syntaxes GDCM decodes, through ITK). Builds without ITK, such as the
+   * Python wheel for the PyPI VTK, read uncompressed DICOM only, through
+   * vtkDICOMImageReader, and name the transfer syntax when they cannot.
+   */
+  static bool CanReadCompressedDICOM();
 
 protected:
   vtkMultiMaterialVolumeReader();

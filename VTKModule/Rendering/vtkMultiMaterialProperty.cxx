@@ -3,6 +3,11 @@
 #include <cstdlib>
 #include <exception>
 
+#if defined(__unix__) || defined(__APPLE__)
+#include <dlfcn.h>
+#endif
+#include <sys/stat.h>
+
 #include <nlohmann/json.hpp>
 #include <vtkObjectFactory.h>
 
@@ -22,10 +27,45 @@ vtkMultiMaterialProperty::vtkMultiMaterialProperty()
 
 vtkMultiMaterialProperty::~vtkMultiMaterialProperty() = default;
 
+namespace
+{
+// The folder of the shared library this code is in ("" if unknown).
+std::string LibraryDirectory()
+{
+#if defined(__unix__) || defined(__APPLE__)
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&LibraryDirectory), &info) && info.dli_fname)
+  {
+    std::string path = info.dli_fname;
+    const auto slash = path.rfind('/');
+    return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+  }
+#endif
+  return {};
+}
+
+bool IsDirectory(const std::string& path)
+{
+  struct stat s;
+  return ::stat(path.c_str(), &s) == 0 && S_ISDIR(s.st_mode);
+}
+}
+
 std::string vtkMultiMaterialProperty::GetPresetDirectory()
 {
   if (const char* env = std::getenv("MMRTM_DATA_DIR"))
     return std::string(env) + "/presets";
+  // Installed: beside the library (the wheel's package folder), or in
+  // share/mmrtm of an install tree; else the source tree's Data folder.
+  const std::string library = LibraryDirectory();
+  if (!library.empty())
+  {
+    for (const char* relative : { "/presets", "/../share/mmrtm/presets" })
+    {
+      if (IsDirectory(library + relative))
+        return library + relative;
+    }
+  }
   return std::string(MMRTM_DATA_DIR) + "/presets";
 }
 

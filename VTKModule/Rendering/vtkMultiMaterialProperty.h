@@ -16,7 +16,9 @@
  *
  * The presets of Data/presets (ct-bone, ct-soft-tissue, ct-angio-labels,
  * ct-organs, mri) are applied with SetPreset; the folder is
- * MMRTM_DATA_DIR/presets (the environment variable, else the source tree's).
+ * MMRTM_DATA_DIR/presets when that environment variable is set, else the
+ * installed presets (beside the library in the Python wheel, in
+ * share/mmrtm/presets of an install tree), else the source tree's.
  */
 #ifndef vtkMultiMaterialProperty_h
 #define vtkMultiMaterialProperty_h

@@ -9,6 +9,8 @@
 
 #include <vtkCamera.h>
 #include <vtkDataArray.h>
+#include <vtkFloatArray.h>
+#include <vtkNew.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkImageData.h>
 #include <vtkLight.h>
@@ -280,6 +282,33 @@ vtkImageData* vtkMultiMaterialVolumeMapper::GetMaskInput()
 int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
 {
   return this->Internal->Film ? static_cast<int>(this->Internal->Film->Samples()) : 0;
+}
+
+void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
+{
+  if (!image)
+    return;
+  image->Initialize();
+  const mmrtm::Film* film = this->Internal->Film.get();
+  if (!film || film->Samples() == 0)
+    return;
+  const int width = film->Width(), height = film->Height();
+  image->SetDimensions(width, height, 1);
+  vtkNew<vtkFloatArray> values;
+  values->SetName("AccumulatedImage");
+  values->SetNumberOfComponents(4);
+  values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
+  for (int y = 0; y < height; ++y)
+  {
+    const int row = height - 1 - y;  // the film's row 0 is the top, VTK's the bottom
+    for (int x = 0; x < width; ++x)
+    {
+      const mmrtm::RGB c = film->Mean(x, y);
+      const float rgba[4] = { c.r, c.g, c.b, film->Alpha(x, y) };
+      values->SetTypedTuple(static_cast<vtkIdType>(row) * width + x, rgba);
+    }
+  }
+  image->GetPointData()->SetScalars(values);
 }
 
 int vtkMultiMaterialVolumeMapper::GetNumberOfSceneBuilds()

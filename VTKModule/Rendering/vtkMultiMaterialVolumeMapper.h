@@ -200,6 +200,15 @@ public:
    */
   int GetAccumulatedSamples();
 
+  /**
+   * The accumulated image before exposure and tone mapping: per pixel the
+   * mean linear radiance (RGB) and coverage (alpha), 4 float components,
+   * row 0 at the bottom as in VTK images. The image is emptied when nothing
+   * has accumulated yet. Renders of one seed and sample count give the same
+   * values at any thread count.
+   */
+  void GetAccumulatedImage(vtkImageData* image);
+
   ///@{
   /**
    * How often the scene was rebuilt (data), refitted (transfer functions)
