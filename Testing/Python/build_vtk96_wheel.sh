@@ -3,7 +3,9 @@
 # user's `pip wheel .` does (in VENV, whose pinned scikit-build-core, CMake
 # and Ninja it uses instead of an isolated build environment, with the build
 # folder kept so that a rebuild is incremental), checks what is in it, and
-# installs it into VENV for the tests that follow.
+# installs it into VENV for the tests that follow. The build folder also gets
+# the regression image program (not part of the wheel), linked against the
+# wheel's VTK, for the image tests of that flavour.
 #
 # Usage: build_vtk96_wheel.sh VENV SOURCE_DIR OUT_DIR
 set -euo pipefail
@@ -12,7 +14,8 @@ rm -rf "$out/dist"
 mkdir -p "$out"
 start=$SECONDS
 "$venv/bin/python" -m pip wheel "$source" --no-build-isolation --no-deps --disable-pip-version-check \
-  -w "$out/dist" --config-settings=build-dir="$out/build"
+  -w "$out/dist" --config-settings=build-dir="$out/build" \
+  --config-settings=cmake.define.MMRTM_VTK_WHEEL_IMAGE_TEST=ON
 echo "built in $((SECONDS - start)) s"
 wheel=("$out"/dist/mmrtm-*.whl)
 [ -f "${wheel[0]}" ] || { echo "no wheel in $out/dist" >&2; exit 1; }
