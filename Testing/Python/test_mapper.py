@@ -417,6 +417,54 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertLess(abs(coverage(s.pixels()) - alone), 0.01)
 
+    def test_noise_target_stops_the_refinement(self):
+        s = Scene()
+        s.mapper.SetMaximumSamples(0)  # no sample limit: only the noise target stops
+        s.render()
+        s.render()
+        noise4 = s.mapper.GetRelativeNoise()
+        self.assertGreater(noise4, 0.0)
+        self.assertFalse(s.mapper.IsConverged())
+        # Noise falls as 1/sqrt(samples): 0.7 of it needs about 8 samples.
+        s.mapper.SetNoiseTarget(0.7 * noise4)
+        samples = []
+        while not s.mapper.IsConverged() and len(samples) < 50:
+            s.render()
+            samples.append(s.mapper.GetAccumulatedSamples())
+        self.assertTrue(s.mapper.IsConverged(), "the noise target was never reached")
+        self.assertLessEqual(s.mapper.GetRelativeNoise(), 0.7 * noise4)
+        self.assertTrue(6 <= samples[-1] <= 16, samples)
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), samples[-1], "converged: no more samples")
+
+    def test_bounces_and_accelerator(self):
+        s = Scene()
+        s.render()
+        lit = s.pixels()
+        # Without bounces nothing scatters light toward the camera: darker.
+        s.mapper.SetMaximumBounces(0)
+        s.render()
+        self.assertEqual(s.counts()[2], 2, "a setting: a restart")
+        dark = s.pixels()
+        self.assertLess(sum(dark), 0.9 * sum(lit))
+        # The accelerators are all unbiased: the same image up to noise, as
+        # far from the octree's as another seed of the octree is.
+        s.mapper.SetMaximumBounces(32)
+
+        def converged():
+            for _ in range(4):
+                s.render()
+            return s.pixels()
+        octree = converged()
+        s.mapper.SetSeed(4)
+        other_seed = mean_abs_difference(octree, converged())
+        s.mapper.SetSeed(3)
+        s.mapper.SetAcceleratorToNone()
+        global_majorant = converged()
+        self.assertGreater(coverage(global_majorant), 0.05)
+        self.assertGreater(other_seed, 0.0)
+        self.assertLess(mean_abs_difference(octree, global_majorant), 1.5 * other_seed)
+
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()
         a.render()

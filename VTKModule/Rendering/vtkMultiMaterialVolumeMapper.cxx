@@ -284,6 +284,24 @@ int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
   return this->Internal->Film ? static_cast<int>(this->Internal->Film->Samples()) : 0;
 }
 
+double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
+{
+  const mmrtm::Film* film = this->Internal->Film.get();
+  return film && film->Samples() >= 2 ? film->Noise().relative : 0.0;
+}
+
+bool vtkMultiMaterialVolumeMapper::IsConverged()
+{
+  const mmrtm::Film* film = this->Internal->Film.get();
+  if (!film)
+    return false;
+  const int accumulated = static_cast<int>(film->Samples());
+  if (this->MaximumSamples > 0 && accumulated >= this->MaximumSamples)
+    return true;
+  // The noise estimate needs two samples; it costs one pass over the film.
+  return this->NoiseTarget > 0 && accumulated >= 2 && film->Noise().relative <= this->NoiseTarget;
+}
+
 void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
 {
   if (!image)
@@ -483,6 +501,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       rs.exposure = static_cast<float>(this->Exposure);
       rs.integrator.seed = static_cast<uint64_t>(this->Seed);
       rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
+      rs.integrator.maxBounces = this->MaximumBounces;
+      rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
+        : this->Accelerator == NO_ACCELERATOR             ? mmrtm::MajorantKind::Global
+                                                          : mmrtm::MajorantKind::Octree;
       rs.integrator.backgroundVisible = false;  // VTK's background shows through
       in.Film = std::make_unique<mmrtm::Film>(width, height);
       in.HasScene = true;
@@ -509,9 +531,9 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     in.Preview.reset();
     const mmrtm::SceneView sceneView = in.Scene.Build();
     const int accumulated = static_cast<int>(in.Film->Samples());
-    const int samples = this->MaximumSamples > 0
-      ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
-      : this->SamplesPerRender;
+    const int samples = this->IsConverged() ? 0
+      : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
+                                            : this->SamplesPerRender;
     if (samples > 0)
       in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
   }
@@ -804,5 +826,8 @@ void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Backend: " << this->Backend << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "ShadowExtinctionScale: " << this->ShadowExtinctionScale << "\n";
+  os << indent << "NoiseTarget: " << this->NoiseTarget << "\n";
+  os << indent << "Accelerator: " << this->Accelerator << "\n";
+  os << indent << "MaximumBounces: " << this->MaximumBounces << "\n";
   os << indent << "AccumulatedSamples: " << (this->Internal->Film ? this->Internal->Film->Samples() : 0) << "\n";
 }

@@ -79,6 +79,17 @@ public:
 
   ///@{
   /**
+   * Relative noise of the accumulated image (Film noise: the root mean
+   * square standard error of the pixels' luminance over their mean
+   * luminance) at which Render() stops adding samples, as it does at
+   * MaximumSamples; 0 (the default) has no noise target.
+   */
+  vtkSetClampMacro(NoiseTarget, double, 0.0, 1.0);
+  vtkGetMacro(NoiseTarget, double);
+  ///@}
+
+  ///@{
+  /**
    * Seed of the random numbers (default 0). Renders of one seed and sample
    * count are identical at any thread count.
    */
@@ -109,6 +120,34 @@ public:
   void SetBackendToAuto() { this->SetBackend(AUTO); }
   void SetBackendToCPU() { this->SetBackend(CPU); }
   void SetBackendToCUDA() { this->SetBackend(CUDA); }
+  ///@}
+
+  enum Accelerators
+  {
+    OCTREE = 0,
+    MACROCELL = 1,
+    NO_ACCELERATOR = 2
+  };
+  ///@{
+  /**
+   * The majorant accelerator of the free-path sampling: OCTREE (default,
+   * the paper's hierarchical grid), MACROCELL (its leaf level alone) or
+   * NO_ACCELERATOR (one global majorant, a baseline). All are unbiased.
+   */
+  vtkSetClampMacro(Accelerator, int, OCTREE, NO_ACCELERATOR);
+  vtkGetMacro(Accelerator, int);
+  void SetAcceleratorToOctree() { this->SetAccelerator(OCTREE); }
+  void SetAcceleratorToMacrocell() { this->SetAccelerator(MACROCELL); }
+  void SetAcceleratorToNone() { this->SetAccelerator(NO_ACCELERATOR); }
+  ///@}
+
+  ///@{
+  /**
+   * Real scattering events per path (default 32): 1 is single scattering
+   * (the lights' direct light only), 0 emission and absorption only.
+   */
+  vtkSetClampMacro(MaximumBounces, int, 0, 1024);
+  vtkGetMacro(MaximumBounces, int);
   ///@}
 
   ///@{
@@ -201,6 +240,19 @@ public:
   int GetAccumulatedSamples();
 
   /**
+   * The relative noise of the accumulated image (see NoiseTarget); 0 before
+   * two samples have accumulated.
+   */
+  double GetRelativeNoise();
+
+  /**
+   * Whether the accumulation has reached MaximumSamples or NoiseTarget, so
+   * that Render() only redraws: an application refining while idle stops
+   * asking for renders then.
+   */
+  bool IsConverged();
+
+  /**
    * The accumulated image before exposure and tone mapping: per pixel the
    * mean linear radiance (RGB) and coverage (alpha), 4 float components,
    * row 0 at the bottom as in VTK images. The image is emptied when nothing
@@ -238,6 +290,9 @@ protected:
   int NumberOfThreads = 0;
   int Backend = AUTO;
   double Exposure = 1.0;
+  double NoiseTarget = 0.0;
+  int Accelerator = OCTREE;
+  int MaximumBounces = 32;
   double ShadowExtinctionScale = 0.8;
   int MaskType = LABELMAP;
   vtkTypeBool InteractiveAdjustResolution = 1;
