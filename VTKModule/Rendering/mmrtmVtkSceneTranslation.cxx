@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <vtkCamera.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkDataArray.h>
@@ -292,6 +293,37 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
   if (selector.keys.empty()) return;
   scene.tfs.push_back(std::move(selector));
   scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1);  // labels first
+}
+
+void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene) {
+  const std::string where = "label " + std::to_string(label) + " material";
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(json);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(where + ": not JSON (" + e.what() + ")");
+  }
+  if (!doc.is_object()) throw InputError(where + ": expected a JSON object");
+  const int index = scene.MaterialIndex("label " + std::to_string(label));
+  if (index < 0) return;
+  MaterialDesc& m = scene.materials[index];
+  auto number = [&](const std::string& key, const nlohmann::json& v, float lo, float hi) {
+    if (!v.is_number() || !(v.get<double>() >= lo && v.get<double>() <= hi))
+      throw InputError(where + "." + key + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return v.get<float>();
+  };
+  for (const auto& [key, value] : doc.items()) {
+    if (key == "roughness") m.base[QuantityOffset(Quantity::Roughness)] = number(key, value, 0.f, 1.f);
+    else if (key == "metallic") m.base[QuantityOffset(Quantity::Metallic)] = number(key, value, 0.f, 1.f);
+    else if (key == "surface_probability") m.base[QuantityOffset(Quantity::SurfaceProbability)] = number(key, value, 0.f, 1.f);
+    else if (key == "anisotropy") m.base[QuantityOffset(Quantity::Anisotropy)] = number(key, value, -0.99f, 0.99f);
+    else if (key == "emission") {
+      if (!value.is_array() || value.size() != 3) throw InputError(where + ".emission: expected [r, g, b]");
+      for (int c = 0; c < 3; ++c) m.base[QuantityOffset(Quantity::Emission) + c] = number(key, value[c], 0.f, 1e6f);
+    } else
+      throw InputError(where + ": unknown key '" + key +
+                       "' (roughness, metallic, surface_probability, anisotropy, emission)");
+  }
 }
 
 void SetCameraFromVtk(vtkCamera* camera, Scene& scene) {

@@ -34,6 +34,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 
 #include "scene.h"
 
@@ -84,6 +85,15 @@ struct ProxyLayout {
 // functions of its own, chosen by an MDPTF over the labels (a label's
 // material wins where its opacity is above zero, DESIGN.md's priority rule).
 void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
+
+// Gives label `label`'s material (made by SetMaterialsFromProperty) the
+// surface and phase parameters VTK's label functions cannot say: a JSON
+// object with any of "roughness", "metallic", "surface_probability" (0..1),
+// "anisotropy" (-1..1) and "emission" ([r, g, b] >= 0). Its colour, opacity
+// and gradient opacity stay the property's. Throws InputError naming the
+// key for an unknown key or a value out of range; a label without a
+// material of its own (no function in the property) is left alone.
+void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene);
 
 // Sets the scene's camera from VTK's.
 void SetCameraFromVtk(vtkCamera* camera, Scene& scene);

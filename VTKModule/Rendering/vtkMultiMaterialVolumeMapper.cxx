@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include <vtkRenderer.h>
 #include <vtkPointData.h>
 #include <vtkTexture.h>
+#include <vtkTimeStamp.h>
 #include <vtkSmartPointer.h>
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
@@ -74,6 +76,10 @@ struct vtkMultiMaterialVolumeMapper::Internals
   vtkDataObject* Data = nullptr;
   vtkMTimeType MaskTime = 0;
   vtkMTimeType DataTime = 0, PropertyTime = 0, MapperTime = 0;
+  // SetLabelMaterialParameters, by label, and when they last changed.
+  std::map<int, std::string> LabelMaterialParameters;
+  vtkTimeStamp LabelMaterialParametersTime;
+  vtkMTimeType LabelMaterialParametersBuilt = 0;
   std::vector<double> View;
   std::vector<float> Depth;  // the depth buffer under the volume at the last restart
   bool HasScene = false, Warned = false;
@@ -284,6 +290,41 @@ int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
   return this->Internal->Film ? static_cast<int>(this->Internal->Film->Samples()) : 0;
 }
 
+void vtkMultiMaterialVolumeMapper::SetLabelMaterialParameters(int label, const char* json)
+{
+  auto& parameters = this->Internal->LabelMaterialParameters;
+  const auto found = parameters.find(label);
+  if (!json || !*json)
+  {
+    if (found == parameters.end())
+      return;
+    parameters.erase(found);
+  }
+  else
+  {
+    if (found != parameters.end() && found->second == json)
+      return;
+    parameters[label] = json;
+  }
+  this->Internal->LabelMaterialParametersTime.Modified();
+  this->Modified();
+}
+
+const char* vtkMultiMaterialVolumeMapper::GetLabelMaterialParameters(int label)
+{
+  const auto found = this->Internal->LabelMaterialParameters.find(label);
+  return found == this->Internal->LabelMaterialParameters.end() ? nullptr : found->second.c_str();
+}
+
+void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterialParameters()
+{
+  if (this->Internal->LabelMaterialParameters.empty())
+    return;
+  this->Internal->LabelMaterialParameters.clear();
+  this->Internal->LabelMaterialParametersTime.Modified();
+  this->Modified();
+}
+
 double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
 {
   const mmrtm::Film* film = this->Internal->Film.get();
@@ -453,10 +494,18 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
     // Transfer functions: translated again and refitted.
     const vtkMTimeType propertyTime = PropertyMTime(property);
-    if (!multi && propertyTime != in.PropertyTime)
+    if (!multi &&
+      (propertyTime != in.PropertyTime ||
+        in.LabelMaterialParametersTime.GetMTime() != in.LabelMaterialParametersBuilt))
     {
       mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene);
+      if (in.Layout.labels >= 0)
+      {
+        for (const auto& [label, json] : in.LabelMaterialParameters)
+          mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
+      }
       in.PropertyTime = propertyTime;
+      in.LabelMaterialParametersBuilt = in.LabelMaterialParametersTime.GetMTime();
       ++in.Refits;
       restart = true;
     }

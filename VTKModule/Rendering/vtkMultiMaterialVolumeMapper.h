@@ -192,6 +192,21 @@ public:
 
   ///@{
   /**
+   * With a LABELMAP mask: surface and phase parameters of label `label`'s
+   * material, which VTK's label functions cannot say (its colour, opacity
+   * and gradient opacity stay the property's). `json` is an object with
+   * any of "roughness", "metallic", "surface_probability" (0 to 1),
+   * "anisotropy" (-1 to 1) and "emission" ([r, g, b]); an unknown key or a
+   * value out of range is an error at the next render. A null or empty
+   * `json` removes the label's parameters. 3D Slicer's segments use this.
+   */
+  void SetLabelMaterialParameters(int label, const char* json);
+  const char* GetLabelMaterialParameters(int label);
+  void RemoveAllLabelMaterialParameters();
+  ///@}
+
+  ///@{
+  /**
    * Materials, BSDF parameters, material transfer functions, lights and
    * presets beyond what vtkVolumeProperty can say. When set, it replaces the
    * translation of the volume property (whose functions are then not used);
