@@ -37,6 +37,20 @@ if(NOT VTK_FOUND)
 endif()
 message(STATUS "VTK ${VTK_VERSION} SDK: ${VTK_DIR}; libraries: ${VTK_WHEEL_LIBRARY_DIR}")
 
+# The 3D Slicer classes (Slicer/, the PyPI Slicer core route) are built when
+# the building Python has slicer-core-sdk and slicer-layer-dm-sdk (then
+# scikit-build-core puts their CMake packages on the prefix path).
+execute_process(
+  COMMAND "${Python3_EXECUTABLE}" -c
+    "import importlib.util as u, sys; sys.exit(0 if u.find_spec('slicer_core_sdk') and u.find_spec('slicer_layer_dm_sdk') else 1)"
+  RESULT_VARIABLE _mmrtm_no_slicer_sdk)
+set(_mmrtm_slicer_default ON)
+if(_mmrtm_no_slicer_sdk)
+  set(_mmrtm_slicer_default OFF)
+endif()
+option(MMRTM_ENABLE_SLICER "Build the 3D Slicer classes against slicer-core-sdk and slicer-layer-dm-sdk" ${_mmrtm_slicer_default})
+message(STATUS "3D Slicer classes (MMRTM_ENABLE_SLICER): ${MMRTM_ENABLE_SLICER}")
+
 # Layout inside site-packages: the package `mmrtm` holds its Python modules
 # and its libraries; they find each other through $ORIGIN and VTK's libraries
 # in the `vtkmodules` folder beside the package.

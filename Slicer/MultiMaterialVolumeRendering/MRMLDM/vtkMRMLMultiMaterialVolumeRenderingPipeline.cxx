@@ -1,0 +1,406 @@
+#include "vtkMRMLMultiMaterialVolumeRenderingPipeline.h"
+
+#include "vtkMRMLMultiMaterialVolumeRenderingDisplayNode.h"
+#include "vtkSlicerMultiMaterialVolumeRenderingLogic.h"
+
+// SlicerLayerDM
+#include <vtkMRMLLayerDMPipelineFactory.h>
+
+// Slicer
+#include <vtkMRMLMarkupsNode.h>
+#include <vtkMRMLMarkupsROINode.h>
+#include <vtkMRMLSegmentationDisplayNode.h>
+#include <vtkMRMLSegmentationNode.h>
+#include <vtkMRMLTransformNode.h>
+#include <vtkMRMLTransformableNode.h>
+#include <vtkMRMLViewNode.h>
+#include <vtkMRMLVolumeNode.h>
+#include <vtkMRMLVolumePropertyNode.h>
+#include <vtkSegment.h>
+#include <vtkSegmentation.h>
+#include <vtkSegmentationConverter.h>
+
+// MM-RTM
+#include <vtkMultiMaterialProperty.h>
+#include <vtkMultiMaterialVolumeMapper.h>
+
+// VTK
+#include <vtkCallbackCommand.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkCommand.h>
+#include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkPiecewiseFunction.h>
+#include <vtkPlane.h>
+#include <vtkPlanes.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringArray.h>
+#include <vtkVolume.h>
+#include <vtkVolumeProperty.h>
+#include <vtkWeakPointer.h>
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkMRMLMultiMaterialVolumeRenderingPipeline);
+
+struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
+{
+  vtkNew<vtkVolume> Volume;
+  vtkNew<vtkMultiMaterialVolumeMapper> Mapper;
+  vtkNew<vtkMultiMaterialProperty> Materials;
+
+  // The nodes this pipeline observes besides its display node.
+  vtkWeakPointer<vtkMRMLNode> VolumeNode, PropertyNode, ROINode, SegmentationNode, SegmentationDisplayNode;
+
+  // With a segmentation: the label map on the volume's grid, the segment
+  // of each label, and a copy of the volume property with the segments'
+  // label functions (the node's own property stays as the user made it).
+  vtkNew<vtkImageData> LabelMap;
+  vtkNew<vtkStringArray> SegmentIds;
+  vtkNew<vtkVolumeProperty> SegmentProperty;
+  std::string LabelMapSignature, LabelFunctionSignature;
+  std::string MaterialDescription = "\n";  // preset and JSON last applied ("\n": none yet)
+
+  std::vector<double> ClipPlanes;  // the planes last applied, by value
+  vtkNew<vtkMatrix4x4> Matrix;
+
+  vtkWeakPointer<vtkRenderer> Renderer;
+  vtkNew<vtkCallbackCommand> RenderEnd;
+};
+
+vtkMRMLMultiMaterialVolumeRenderingPipeline::vtkMRMLMultiMaterialVolumeRenderingPipeline()
+  : Internal(new Internals)
+{
+  Internals& in = *this->Internal;
+  in.Volume->SetMapper(in.Mapper);
+  in.Volume->VisibilityOff();
+  in.Volume->PickableOff();
+  in.RenderEnd->SetClientData(this);
+  in.RenderEnd->SetCallback([](vtkObject*, unsigned long, void* self, void*)
+    { static_cast<vtkMRMLMultiMaterialVolumeRenderingPipeline*>(self)->OnRenderEnd(); });
+}
+
+vtkMRMLMultiMaterialVolumeRenderingPipeline::~vtkMRMLMultiMaterialVolumeRenderingPipeline()
+{
+  if (this->Internal->Renderer)
+    this->OnRendererRemoved(this->Internal->Renderer);
+}
+
+bool vtkMRMLMultiMaterialVolumeRenderingPipeline::RegisterPipelineCreator()
+{
+  static bool registered = false;
+  if (registered)
+    return false;
+  registered = true;
+  vtkMRMLLayerDMPipelineFactory::GetInstance()->AddPipelineCreator(
+    [](vtkMRMLAbstractViewNode* viewNode, vtkMRMLNode* node) -> vtkSmartPointer<vtkMRMLLayerDMPipeline>
+    {
+      if (!vtkMRMLViewNode::SafeDownCast(viewNode) || !vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(node))
+        return nullptr;
+      auto pipeline = vtkSmartPointer<vtkMRMLMultiMaterialVolumeRenderingPipeline>::New();
+      pipeline->SetViewNode(viewNode);
+      pipeline->SetDisplayNode(node);
+      return pipeline;
+    });
+  return true;
+}
+
+vtkMultiMaterialVolumeMapper* vtkMRMLMultiMaterialVolumeRenderingPipeline::GetMapper()
+{
+  return this->Internal->Mapper;
+}
+
+vtkVolume* vtkMRMLMultiMaterialVolumeRenderingPipeline::GetVolume()
+{
+  return this->Internal->Volume;
+}
+
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::SetDisplayNode(vtkMRMLNode* displayNode)
+{
+  this->Superclass::SetDisplayNode(displayNode);
+  this->UpdateObservedNodes();
+}
+
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::OnRendererAdded(vtkRenderer* renderer)
+{
+  Internals& in = *this->Internal;
+  if (!renderer)
+    return;
+  renderer->AddVolume(in.Volume);
+  renderer->AddObserver(vtkCommand::EndEvent, in.RenderEnd);
+  in.Renderer = renderer;
+}
+
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::OnRendererRemoved(vtkRenderer* renderer)
+{
+  Internals& in = *this->Internal;
+  if (!renderer)
+    return;
+  renderer->RemoveObserver(in.RenderEnd);
+  renderer->RemoveVolume(in.Volume);
+  // The texture the image is drawn with belongs to this window's context.
+  if (vtkRenderWindow* window = renderer->GetRenderWindow())
+    in.Volume->ReleaseGraphicsResources(window);
+  if (in.Renderer == renderer)
+    in.Renderer = nullptr;
+}
+
+// While the image is not converged, each render asks for another one: the
+// view refines while it is idle (Slicer's views compress the requests).
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::OnRenderEnd()
+{
+  Internals& in = *this->Internal;
+  if (in.Volume->GetVisibility() && in.Mapper->GetAccumulatedSamples() > 0 && !in.Mapper->IsConverged())
+    this->RequestRender();
+}
+
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::OnUpdate(vtkObject* object, unsigned long eventId, void* callData)
+{
+  this->Superclass::OnUpdate(object, eventId, callData);
+  this->UpdateDisplay();
+}
+
+// Observes what the display node refers to; the references may change at
+// any update.
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateObservedNodes()
+{
+  Internals& in = *this->Internal;
+  auto* node = vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(this->GetDisplayNode());
+  vtkMRMLNode* volume = node ? node->GetVolumeNode() : nullptr;
+  vtkMRMLNode* property = node ? node->GetVolumePropertyNode() : nullptr;
+  vtkMRMLNode* roi = node ? node->GetROINode() : nullptr;
+  vtkMRMLSegmentationNode* segmentation = node ? node->GetSegmentationNode() : nullptr;
+  vtkMRMLNode* segmentationDisplay = segmentation ? segmentation->GetDisplayNode() : nullptr;
+
+  const std::vector<unsigned long> volumeEvents{ vtkCommand::ModifiedEvent,
+    vtkMRMLVolumeNode::ImageDataModifiedEvent, vtkMRMLTransformableNode::TransformModifiedEvent };
+  const std::vector<unsigned long> roiEvents{ vtkCommand::ModifiedEvent, vtkMRMLMarkupsNode::PointModifiedEvent,
+    vtkMRMLTransformableNode::TransformModifiedEvent };
+  const std::vector<unsigned long> segmentationEvents{ vtkCommand::ModifiedEvent,
+    vtkMRMLTransformableNode::TransformModifiedEvent, vtkSegmentation::SegmentAdded, vtkSegmentation::SegmentRemoved,
+    vtkSegmentation::SegmentModified, vtkSegmentation::SourceRepresentationModified };
+  this->UpdateObservation(in.VolumeNode, volume, volumeEvents);
+  this->UpdateObservation(in.PropertyNode, property, vtkCommand::ModifiedEvent);
+  this->UpdateObservation(in.ROINode, roi, roiEvents);
+  this->UpdateObservation(in.SegmentationNode, segmentation, segmentationEvents);
+  this->UpdateObservation(in.SegmentationDisplayNode, segmentationDisplay, vtkCommand::ModifiedEvent);
+  in.VolumeNode = volume;
+  in.PropertyNode = property;
+  in.ROINode = roi;
+  in.SegmentationNode = segmentation;
+  in.SegmentationDisplayNode = segmentationDisplay;
+}
+
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateFromMRML()
+{
+  Internals& in = *this->Internal;
+  this->UpdateObservedNodes();
+  auto* node = vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(this->GetDisplayNode());
+  vtkMRMLAbstractViewNode* view = this->GetViewNode();
+  vtkMRMLVolumeNode* volumeNode = node ? node->GetVolumeNode() : nullptr;
+  vtkMRMLVolumePropertyNode* propertyNode = node ? node->GetVolumePropertyNode() : nullptr;
+  const bool visible = node && view && volumeNode && volumeNode->GetImageData() && propertyNode &&
+    propertyNode->GetVolumeProperty() && node->GetVisibility(view->GetID()) && node->GetVisibility3D();
+  if (!visible)
+  {
+    in.Volume->VisibilityOff();
+    return;
+  }
+  if (in.Mapper->GetInput() != volumeNode->GetImageData())
+    in.Mapper->SetInputData(volumeNode->GetImageData());
+  vtkSlicerMultiMaterialVolumeRenderingLogic::ApplyRenderSettings(node, in.Mapper);
+  this->UpdateGeometry();
+  this->UpdateProperty();
+  this->UpdateCropping();
+  in.Volume->VisibilityOn();
+}
+
+// IJK to world: the volume's IJK-to-RAS matrix under its parent transforms.
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateGeometry()
+{
+  Internals& in = *this->Internal;
+  auto* node = vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(this->GetDisplayNode());
+  vtkMRMLVolumeNode* volumeNode = node->GetVolumeNode();
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  volumeNode->GetIJKToRASMatrix(ijkToRas);
+  vtkNew<vtkMatrix4x4> toWorld;
+  if (vtkMRMLTransformNode* parent = volumeNode->GetParentTransformNode())
+  {
+    if (!parent->IsTransformToWorldLinear())
+      vtkWarningMacro("volume " << volumeNode->GetName() << " is under a non-linear transform; only its linear part "
+                                << "is rendered");
+    parent->GetMatrixTransformToWorld(toWorld);
+  }
+  vtkNew<vtkMatrix4x4> matrix;
+  vtkMatrix4x4::Multiply4x4(toWorld, ijkToRas, matrix);
+  bool same = true;
+  for (int i = 0; i < 16; ++i)
+    same = same && matrix->GetData()[i] == in.Matrix->GetData()[i];
+  if (!same)
+  {
+    in.Matrix->DeepCopy(matrix);
+    in.Volume->SetUserMatrix(in.Matrix);
+    in.Volume->Modified();
+  }
+}
+
+namespace
+{
+// What the label functions are made of: per segment its ID, colour,
+// visibility and 3D opacity, and the property's opacity unit distance.
+std::string LabelFunctionSignature(vtkMRMLSegmentationNode* segmentation, vtkStringArray* ids, double unitDistance)
+{
+  std::ostringstream s;
+  s.precision(17);
+  s << unitDistance;
+  auto* display = vtkMRMLSegmentationDisplayNode::SafeDownCast(segmentation->GetDisplayNode());
+  for (vtkIdType i = 0; i < ids->GetNumberOfValues(); ++i)
+  {
+    const std::string id = ids->GetValue(i);
+    double rgb[3] = { 0, 0, 0 };
+    if (vtkSegment* segment = segmentation->GetSegmentation()->GetSegment(id))
+      segment->GetColor(rgb);
+    if (display)
+      display->GetSegmentColor(id, rgb);
+    s << ';' << id << ',' << rgb[0] << ',' << rgb[1] << ',' << rgb[2];
+    if (display)
+      s << ',' << display->GetSegmentVisibility(id) << display->GetSegmentVisibility3D(id) << ','
+        << display->GetSegmentOpacity3D(id);
+  }
+  return s.str();
+}
+
+// What the label map is made of: the segments, their order and their
+// binary labelmaps, the volume's grid and both nodes' transforms.
+std::string LabelMapSignature(vtkMRMLSegmentationNode* segmentation, vtkMRMLVolumeNode* volume)
+{
+  std::ostringstream s;
+  vtkSegmentation* segments = segmentation->GetSegmentation();
+  std::vector<std::string> ids;
+  segments->GetSegmentIDs(ids);
+  const char* labelmap = vtkSegmentationConverter::GetBinaryLabelmapRepresentationName();
+  for (const std::string& id : ids)
+  {
+    s << id << ':';
+    if (vtkSegment* segment = segments->GetSegment(id))
+      if (vtkDataObject* data = segment->GetRepresentation(labelmap))
+        s << data << '@' << data->GetMTime();
+    s << ';';
+  }
+  s << volume->GetImageData() << '@' << volume->GetImageData()->GetMTime() << ';' << volume->GetMTime();
+  for (vtkMRMLTransformableNode* node : { static_cast<vtkMRMLTransformableNode*>(volume),
+         static_cast<vtkMRMLTransformableNode*>(segmentation) })
+  {
+    vtkMRMLTransformNode* parent = node->GetParentTransformNode();
+    s << ';' << parent << '@' << (parent ? parent->GetTransformToWorldMTime() : 0);
+  }
+  return s.str();
+}
+}
+
+// The property the mapper translates: the volume property node's own, or
+// with a segmentation a copy of it with the segments as label functions;
+// then the material preset and the segments' material parameters.
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
+{
+  Internals& in = *this->Internal;
+  auto* node = vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(this->GetDisplayNode());
+  vtkVolumeProperty* property = node->GetVolumePropertyNode()->GetVolumeProperty();
+  vtkMRMLSegmentationNode* segmentation = node->GetSegmentationNode();
+  bool labels = false;
+  if (segmentation && segmentation->GetSegmentation())
+  {
+    const std::string mapSignature = LabelMapSignature(segmentation, node->GetVolumeNode());
+    if (mapSignature != in.LabelMapSignature)
+    {
+      vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(node, in.LabelMap, in.SegmentIds);
+      in.LabelMap->Modified();
+      in.LabelMapSignature = mapSignature;
+      in.LabelFunctionSignature.clear();
+    }
+    labels = in.SegmentIds->GetNumberOfValues() > 0;
+  }
+  if (labels)
+  {
+    // The copy is made again when the property or a segment's look changed.
+    std::ostringstream signature;
+    signature << property << '@' << property->GetMTime();
+    for (vtkObject* f : { static_cast<vtkObject*>(property->GetScalarOpacity()),
+           static_cast<vtkObject*>(property->GetRGBTransferFunction()),
+           static_cast<vtkObject*>(property->GetGradientOpacity()) })
+      signature << ',' << (f ? f->GetMTime() : 0);
+    signature << ';' << LabelFunctionSignature(segmentation, in.SegmentIds, property->GetScalarOpacityUnitDistance());
+    if (signature.str() != in.LabelFunctionSignature)
+    {
+      in.SegmentProperty->DeepCopy(property);
+      vtkSlicerMultiMaterialVolumeRenderingLogic::SetSegmentLabelFunctions(node, in.SegmentIds, in.SegmentProperty);
+      in.LabelFunctionSignature = signature.str();
+    }
+    if (in.Mapper->GetMaskInput() != in.LabelMap.GetPointer())
+      in.Mapper->SetMaskInput(in.LabelMap);
+    in.Mapper->SetMaskTypeToLabelMap();
+    if (in.Volume->GetProperty() != in.SegmentProperty.GetPointer())
+      in.Volume->SetProperty(in.SegmentProperty);
+    vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentMaterialParameters(node, in.SegmentIds, in.Mapper);
+  }
+  else
+  {
+    if (in.Mapper->GetMaskInput())
+      in.Mapper->SetMaskInput(nullptr);
+    if (in.Volume->GetProperty() != property)
+      in.Volume->SetProperty(property);
+  }
+
+  const std::string description = std::string(node->GetMaterialPreset()) + '\n' + node->GetSceneJSON();
+  if (description != in.MaterialDescription)
+  {
+    const bool useMaterials = vtkSlicerMultiMaterialVolumeRenderingLogic::ApplyMaterialDescription(node, in.Materials);
+    in.Mapper->SetMultiMaterialProperty(useMaterials ? in.Materials.GetPointer() : nullptr);
+    in.MaterialDescription = description;
+  }
+}
+
+// Cropping by the ROI: its six faces, normals inward, as clipping planes in
+// world space (they change the mapper only when their values change).
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateCropping()
+{
+  Internals& in = *this->Internal;
+  auto* node = vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(this->GetDisplayNode());
+  std::vector<double> values;
+  vtkNew<vtkPlanes> planes;
+  if (auto* roi = vtkMRMLMarkupsROINode::SafeDownCast(node->GetROINode()); roi && node->GetCroppingEnabled())
+  {
+    roi->GetPlanesWorld(planes, !roi->GetInsideOut());
+    for (int i = 0; i < planes->GetNumberOfPlanes(); ++i)
+    {
+      vtkPlane* plane = planes->GetPlane(i);
+      values.insert(values.end(), plane->GetOrigin(), plane->GetOrigin() + 3);
+      values.insert(values.end(), plane->GetNormal(), plane->GetNormal() + 3);
+    }
+  }
+  if (values == in.ClipPlanes)
+    return;
+  in.Mapper->RemoveAllClippingPlanes();
+  for (size_t i = 0; i < values.size(); i += 6)
+  {
+    vtkNew<vtkPlane> plane;
+    plane->SetOrigin(values[i], values[i + 1], values[i + 2]);
+    plane->SetNormal(values[i + 3], values[i + 4], values[i + 5]);
+    in.Mapper->AddClippingPlane(plane);
+  }
+  in.ClipPlanes = std::move(values);
+}
+
+void vtkMRMLMultiMaterialVolumeRenderingPipeline::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Segments: " << this->Internal->SegmentIds->GetNumberOfValues() << "\n";
+  os << indent << "AccumulatedSamples: " << this->Internal->Mapper->GetAccumulatedSamples() << "\n";
+}
