@@ -87,6 +87,15 @@ vtkSlicerVolumeRenderingLogic* vtkSlicerMultiMaterialVolumeRenderingLogic::GetVo
   return this->VolumeRenderingLogic;
 }
 
+bool vtkSlicerMultiMaterialVolumeRenderingLogic::IsRenderingMethodRegistered()
+{
+  if (!this->VolumeRenderingLogic)
+    return false;
+  const auto methods = this->VolumeRenderingLogic->GetRenderingMethods();
+  const auto found = methods.find(GetRenderingMethodName());
+  return found != methods.end() && found->second == "vtkMRMLMultiMaterialVolumeRenderingDisplayNode";
+}
+
 void vtkSlicerMultiMaterialVolumeRenderingLogic::ApplyRenderSettings(
   vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkMultiMaterialVolumeMapper* mapper)
 {

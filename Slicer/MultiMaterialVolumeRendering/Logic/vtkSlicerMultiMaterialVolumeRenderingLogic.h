@@ -54,6 +54,10 @@ public:
   vtkSlicerVolumeRenderingLogic* GetVolumeRenderingLogic();
   ///@}
 
+  /// Whether the Volume Rendering logic lists the method (its method list
+  /// is a std::map, out of Python's reach).
+  bool IsRenderingMethodRegistered();
+
   /// Puts the node's render settings on the mapper: samples per render,
   /// maximum samples, noise target, bounces, shadow extinction scale,
   /// accelerator, backend, seed. Unchanged values change nothing.

@@ -64,7 +64,7 @@ struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
   // label functions (the node's own property stays as the user made it).
   vtkNew<vtkImageData> LabelMap;
   vtkNew<vtkStringArray> SegmentIds;
-  vtkNew<vtkVolumeProperty> SegmentProperty;
+  vtkSmartPointer<vtkVolumeProperty> SegmentProperty;
   std::string LabelMapSignature, LabelFunctionSignature;
   std::string MaterialDescription = "\n";  // preset and JSON last applied ("\n": none yet)
 
@@ -337,8 +337,11 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
            static_cast<vtkObject*>(property->GetGradientOpacity()) })
       signature << ',' << (f ? f->GetMTime() : 0);
     signature << ';' << LabelFunctionSignature(segmentation, in.SegmentIds, property->GetScalarOpacityUnitDistance());
-    if (signature.str() != in.LabelFunctionSignature)
+    if (signature.str() != in.LabelFunctionSignature || !in.SegmentProperty)
     {
+      // A new copy: DeepCopy would keep the label functions of segments
+      // that are hidden now.
+      in.SegmentProperty = vtkSmartPointer<vtkVolumeProperty>::New();
       in.SegmentProperty->DeepCopy(property);
       vtkSlicerMultiMaterialVolumeRenderingLogic::SetSegmentLabelFunctions(node, in.SegmentIds, in.SegmentProperty);
       in.LabelFunctionSignature = signature.str();
@@ -346,7 +349,7 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
     if (in.Mapper->GetMaskInput() != in.LabelMap.GetPointer())
       in.Mapper->SetMaskInput(in.LabelMap);
     in.Mapper->SetMaskTypeToLabelMap();
-    if (in.Volume->GetProperty() != in.SegmentProperty.GetPointer())
+    if (in.Volume->GetProperty() != in.SegmentProperty)
       in.Volume->SetProperty(in.SegmentProperty);
     vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentMaterialParameters(node, in.SegmentIds, in.Mapper);
   }

@@ -1,0 +1,373 @@
+"""Path tracing (MM-RTM) as a rendering method of 3D Slicer's Volume Rendering
+module, tested headless on the PyPI Slicer core (slicer-core 5.11, slicer-
+layer-dm 2.0, vtk 9.6) as a user would use it: volumes loaded by Slicer's
+volumes logic, display nodes made by the Volume Rendering logic, rendered by
+the displayable managers of a 3D view (LayerDM's, and Slicer's own volume
+rendering manager, which must ignore our node).
+
+Run by ctest under xvfb-run with the .venv-vtk96 interpreter, after the
+mmrtm wheel (with its Slicer classes) was built and installed there.
+"""
+import os
+import tempfile
+import unittest
+
+from vtkmodules.vtkCommonDataModel import vtkImageData
+from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow, vtkVolume
+from vtkmodules.vtkCommonMath import vtkMatrix4x4
+
+from slicer import (vtkMRMLLinearTransformNode, vtkMRMLMarkupsROINode, vtkMRMLMultiMaterialVolumeRenderingDisplayNode,
+                    vtkMRMLScene, vtkMRMLSegmentationNode)
+from mmrtm import vtkMultiMaterialVolumeMapper
+
+from slicer_test_scene import (CPU_METHOD, DATA, METHOD, SlicerScene, covered, intersection_over_union,
+                               mean_abs_difference, presets_directory)
+
+NEEDS_PRESETS = unittest.skipUnless(presets_directory(), "Slicer's presets.xml comes with trame-slicer, not installed")
+
+
+def film(mapper):
+    image = vtkImageData()
+    mapper.GetAccumulatedImage(image)
+    return bytes(memoryview(image.GetPointData().GetScalars())) if image.GetNumberOfPoints() else b""
+
+
+def head_ct(s, **settings):
+    volume = s.load_volume(os.path.join(DATA, "ct_head_cranium.nrrd"), "head")
+    display = s.show_with_path_tracing(volume, **settings)
+    return volume, display
+
+
+class MethodTest(unittest.TestCase):
+    def test_registered_with_the_volume_rendering_module(self):
+        s = SlicerScene()
+        self.assertIs(s.logic.GetVolumeRenderingLogic(), s.volume_rendering,
+                      "found through the application logic, as in Slicer")
+        self.assertTrue(s.logic.IsRenderingMethodRegistered())
+        self.assertTrue(s.scene.IsNodeClassRegistered(METHOD))
+        self.assertEqual(s.logic.GetRenderingMethodName(), "Path tracing (MM-RTM)")
+
+    def test_from_slicer_import(self):
+        import slicer
+        self.assertIs(slicer.vtkMRMLMultiMaterialVolumeRenderingDisplayNode, vtkMRMLMultiMaterialVolumeRenderingDisplayNode)
+        self.assertTrue(hasattr(slicer, "vtkSlicerMultiMaterialVolumeRenderingLogic"))
+        self.assertTrue(hasattr(slicer, "vtkMRMLMultiMaterialVolumeRenderingPipeline"))
+
+
+@NEEDS_PRESETS
+class RenderTest(unittest.TestCase):
+    def render_and_compare(self, load, preset, azimuth, name):
+        s = SlicerScene()
+        view = s.add_view()
+        volume = load(s)
+        display = s.show_with_path_tracing(volume, preset=preset)
+        view.look_at_volume(azimuth=azimuth)
+        renders = view.refine()
+        mapper = view.mapper()
+        self.assertEqual(mapper.GetAccumulatedSamples(), 8)
+        self.assertEqual(renders, 2, "4 samples per render up to 8")
+        self.assertEqual(len(view.volumes()), 1, "Slicer's own volume rendering manager ignores the node")
+        ours = view.pixels()
+        coverage = sum(covered(ours)) / len(ours)
+        self.assertTrue(0.05 < coverage < 0.95, "coverage %.3f: an empty or full image" % coverage)
+
+        # The same volume, property, geometry and camera with the mapper alone,
+        # outside Slicer: the same film to the bit (one seed, one translation).
+        renderer = vtkRenderer()
+        window = vtkRenderWindow()
+        window.SetOffScreenRendering(1)
+        window.AddRenderer(renderer)
+        window.SetSize(*view.window.GetSize())
+        alone = vtkMultiMaterialVolumeMapper()
+        alone.SetInputData(volume.GetImageData())
+        alone.SetSamplesPerRender(4)
+        alone.SetMaximumSamples(8)
+        alone.SetSeed(5)
+        alone.SetBackendToCPU()
+        prop = vtkVolume()
+        prop.SetMapper(alone)
+        prop.SetProperty(display.GetVolumePropertyNode().GetVolumeProperty())
+        ijk_to_ras = vtkMatrix4x4()
+        volume.GetIJKToRASMatrix(ijk_to_ras)
+        prop.SetUserMatrix(ijk_to_ras)
+        renderer.AddVolume(prop)
+        renderer.GetActiveCamera().DeepCopy(view.renderer.GetActiveCamera())
+        renderer.ResetCameraClippingRange()
+        window.Render()
+        window.Render()
+        self.assertEqual(alone.GetAccumulatedSamples(), 8)
+        self.assertEqual(film(alone), film(mapper), "the mapper's own film of the same volume and property")
+
+        # Slicer's CPU ray cast of the same display node covers the same pixels.
+        s.volume_rendering.ChangeVolumeRenderingMethod(CPU_METHOD)
+        view.render()
+        view.render()
+        self.assertEqual([v.GetMapper().GetClassName() for v in view.volumes() if v.GetVisibility()],
+                         ["vtkFixedPointVolumeRayCastMapper"])
+        iou = intersection_over_union(covered(ours), covered(view.pixels()))
+        print("%s: coverage %.3f, IoU with Slicer's CPU ray cast %.3f" % (name, coverage, iou))
+        self.assertGreater(iou, 0.85)
+        return s
+
+    def test_head_ct_nrrd(self):
+        self.render_and_compare(lambda s: s.load_volume(os.path.join(DATA, "ct_head_cranium.nrrd"), "head"),
+                                "CT-Bone", 180, "head")
+
+    def test_chest_ct_dicom_series(self):
+        self.render_and_compare(lambda s: s.load_dicom_series(os.path.join(DATA, "ct_chest_dicom"), "chest"),
+                                "CT-Bone", 0, "chest")
+
+
+@NEEDS_PRESETS
+class ViewTest(unittest.TestCase):
+    def setUp(self):
+        self.s = SlicerScene()
+        self.view = self.s.add_view()
+        self.volume, self.display = head_ct(self.s)
+        self.view.look_at_volume(azimuth=180)
+        self.view.refine()
+        self.before = self.view.pixels()
+
+    def counts(self):
+        m = self.view.mapper()
+        return m.GetNumberOfSceneBuilds(), m.GetNumberOfRefits(), m.GetNumberOfRestarts()
+
+    def test_a_transform_moves_the_image(self):
+        transform = self.s.scene.AddNewNodeByClass("vtkMRMLLinearTransformNode", "move")
+        matrix = vtkMatrix4x4()
+        matrix.SetElement(0, 3, -60.0)  # 60 mm to the patient's right: to the left on screen from behind
+        transform.SetMatrixTransformToParent(matrix)
+        restarts = self.counts()[2]
+        self.volume.SetAndObserveTransformNodeID(transform.GetID())
+        self.view.refine()
+        self.assertEqual(self.counts()[2], restarts + 1, "a new matrix restarts")
+        after = self.view.pixels()
+
+        def centre_x(pixels):
+            size = self.view.window.GetSize()[0]
+            xs = [i % size for i, c in enumerate(covered(pixels)) if c]
+            return sum(xs) / len(xs)
+        shift = centre_x(after) - centre_x(self.before)
+        self.assertGreater(abs(shift), 5, "the volume moved on screen (%.1f pixels)" % shift)
+        # Editing the transform moves it again.
+        matrix.SetElement(0, 3, 0.0)
+        transform.SetMatrixTransformToParent(matrix)
+        self.view.refine()
+        self.assertLess(abs(centre_x(self.view.pixels()) - centre_x(self.before)), 1.0)
+
+    def test_the_roi_crops(self):
+        roi = self.s.scene.AddNewNodeByClass("vtkMRMLMarkupsROINode", "crop")
+        bounds = [0.0] * 6
+        self.volume.GetRASBounds(bounds)
+        # The half of the volume with the larger R (patient's left).
+        roi.SetXYZ((bounds[0] + bounds[1]) / 2 + (bounds[1] - bounds[0]) / 4, (bounds[2] + bounds[3]) / 2,
+                   (bounds[4] + bounds[5]) / 2)
+        roi.SetRadiusXYZ((bounds[1] - bounds[0]) / 4, (bounds[3] - bounds[2]) / 2 + 1, (bounds[5] - bounds[4]) / 2 + 1)
+        self.display.SetAndObserveROINodeID(roi.GetID())
+        self.display.SetCroppingEnabled(True)
+        self.view.refine()
+        whole = sum(covered(self.before))
+        cropped = sum(covered(self.view.pixels()))
+        self.assertLess(cropped, 0.75 * whole)
+        self.assertGreater(cropped, 0.25 * whole)
+        # Moving the ROI changes the crop; cropping off shows it all again.
+        self.display.SetCroppingEnabled(False)
+        self.view.refine()
+        self.assertEqual(self.view.pixels(), self.before, "cropping off: the same image as before")
+
+    def test_hidden_in_one_view_only(self):
+        second = self.s.add_view("View2")
+        second.renderer.GetActiveCamera().DeepCopy(self.view.renderer.GetActiveCamera())
+        self.display.SetViewNodeIDs([self.view.node.GetID()])
+        self.view.refine()
+        second.refine()
+        self.assertGreater(sum(covered(self.view.pixels())), 0.05 * len(self.before), "shown where listed")
+        self.assertEqual(sum(covered(second.pixels())), 0, "hidden in the other view")
+        self.display.SetViewNodeIDs([])
+        second.refine()
+        self.assertGreater(sum(covered(second.pixels())), 0.05 * len(self.before), "shown everywhere again")
+        self.display.SetVisibility(False)
+        self.view.render()
+        self.assertEqual(sum(covered(self.view.pixels())), 0, "display node hidden")
+
+    def test_preset_switch_refits_and_property_edit_restarts(self):
+        builds, refits, restarts = self.counts()
+        self.s.apply_preset(self.display, "CT-Soft-Tissue")
+        self.view.render()
+        self.assertEqual(self.counts(), (builds, refits + 1, restarts + 1), "a new preset: a refit, no rebuild")
+        self.view.refine()
+        soft = self.view.pixels()
+        self.assertGreater(mean_abs_difference(soft, self.before), 0.01, "the preset changes the image")
+        # An edit of the property's opacity function restarts the accumulation.
+        opacity = self.display.GetVolumePropertyNode().GetVolumeProperty().GetScalarOpacity()
+        opacity.AddPoint(100.0, 0.0)
+        self.view.render()
+        self.assertEqual(self.view.mapper().GetAccumulatedSamples(), 4, "restarted")
+        self.assertEqual(self.counts()[1], refits + 2)
+
+    def test_refinement_stops_at_the_noise_target(self):
+        self.display.SetMaximumSamples(0)
+        self.display.SetNoiseTarget(0.9 * self.view.mapper().GetRelativeNoise())
+        renders = self.view.refine(limit=40)
+        self.assertTrue(self.view.mapper().IsConverged())
+        self.assertLessEqual(self.view.mapper().GetRelativeNoise(), self.display.GetNoiseTarget())
+        self.assertGreater(renders, 1)
+
+
+@NEEDS_PRESETS
+class SegmentationTest(unittest.TestCase):
+    """ct_abdomen with its 61-label map (TotalSegmentator) as a segmentation."""
+
+    LIVER = 5
+
+    def setUp(self):
+        s = self.s = SlicerScene()
+        self.view = s.add_view()
+        self.ct = s.load_volume(os.path.join(DATA, "ct_abdomen.nii.gz"), "abdomen")
+        labels = s.load_volume(os.path.join(DATA, "ct_abdomen_labels.nii.gz"), "labels", labelmap=True)
+        self.segmentation = s.scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "organs")
+        self.segmentation.CreateDefaultDisplayNodes()
+        self.assertTrue(s.segmentations.ImportLabelmapToSegmentationNode(labels, self.segmentation))
+        segments = self.segmentation.GetSegmentation()
+        self.assertEqual(segments.GetNumberOfSegments(), 61)
+        self.liver = [segments.GetNthSegmentID(i) for i in range(61)
+                      if segments.GetNthSegment(i).GetLabelValue() == self.LIVER][0]
+        self.display = s.show_with_path_tracing(self.ct, preset="CT-Soft-Tissue", maximum_samples=4)
+        # Only the segments show: the volume property itself transparent.
+        self.display.GetVolumePropertyNode().GetVolumeProperty().GetScalarOpacity().RemoveAllPoints()
+        self.display.GetVolumePropertyNode().GetVolumeProperty().GetScalarOpacity().AddPoint(0, 0.0)
+        self.display.SetAndObserveSegmentationNodeID(self.segmentation.GetID())
+        self.seg_display = self.segmentation.GetDisplayNode()
+        for i in range(61):
+            self.seg_display.SetSegmentOverrideColor(segments.GetNthSegmentID(i), 1.0, 0.0, 0.0)
+        self.view.look_at_volume()
+        self.view.refine()
+
+    def colours(self):
+        pixels = self.view.pixels()
+        red = sum(1 for r, g, b in pixels if r > 40 and r > 2 * g and r > 2 * b)
+        blue = sum(1 for r, g, b in pixels if b > 40 and b > 2 * r and b > 2 * g)
+        return red, blue
+
+    def counts(self):
+        m = self.view.mapper()
+        return m.GetNumberOfSceneBuilds(), m.GetNumberOfRefits(), m.GetNumberOfRestarts()
+
+    def test_segments_render_in_their_colours(self):
+        red, blue = self.colours()
+        self.assertGreater(red, 0.05 * len(self.view.pixels()), "the red segments show")
+        self.assertEqual(blue, 0)
+        builds, refits, restarts = self.counts()
+        self.seg_display.SetSegmentOverrideColor(self.liver, 0.0, 0.0, 1.0)
+        self.view.render()
+        self.assertEqual(self.counts(), (builds, refits + 1, restarts + 1), "a colour: a refit, no rebuild")
+        self.view.refine()
+        red2, blue2 = self.colours()
+        print("red %d, blue %d pixels after the liver turned blue (red %d before)" % (red2, blue2, red))
+        self.assertGreater(blue2, 200, "the liver is blue")
+        self.assertGreater(red2, 0.3 * red, "the other segments stay red")
+
+    def test_hiding_a_segment_removes_it_and_leaves_the_others(self):
+        self.seg_display.SetSegmentOverrideColor(self.liver, 0.0, 0.0, 1.0)
+        self.view.refine()
+        red, blue = self.colours()
+        self.assertGreater(blue, 200)
+        self.seg_display.SetSegmentVisibility(self.liver, False)
+        self.view.refine()
+        red2, blue2 = self.colours()
+        self.assertLess(blue2, 0.02 * blue, "the hidden liver is gone")
+        self.assertGreater(red2, 0.9 * red, "the other segments stay (and show behind the liver)")
+
+    def test_segment_material_parameters(self):
+        before = self.view.pixels()
+        self.display.SetSegmentMaterialParameters(self.liver, '{"emission": [0, 3, 0]}')
+        self.view.refine()
+        self.assertEqual(self.view.mapper().GetLabelMaterialParameters(self.LIVER), '{"emission": [0, 3, 0]}')
+        greener = sum(p[1] - q[1] for p, q in zip(self.view.pixels(), before)) / len(before)
+        self.assertGreater(greener, 0.5, "the liver glows green")
+
+
+@NEEDS_PRESETS
+class SceneFileTest(unittest.TestCase):
+    def test_saved_scene_reloads_to_the_same_render(self):
+        s = SlicerScene()
+        view = s.add_view()
+        volume, display = head_ct(s, seed=11)
+        display.SetMaximumBounces(5)
+        display.SetShadowExtinctionScale(1.0)
+        display.SetAccelerator(display.Macrocell)
+        display.SetSegmentMaterialParameters("S_x=1;", '{"roughness": 0.25}')
+        view.look_at_volume(azimuth=180)
+        view.refine()
+        first = film(view.mapper())
+        with tempfile.TemporaryDirectory() as folder:
+            self.assertTrue(s.app.SaveSceneToSlicerDataBundleDirectory(folder, None))
+            mrml = [f for f in os.listdir(folder) if f.endswith(".mrml")][0]
+            t = SlicerScene()
+            t.scene.SetURL(os.path.join(folder, mrml))
+            self.assertEqual(t.scene.Import(), 1)
+            nodes = t.scene.GetNodesByClass(METHOD)
+            self.assertEqual(nodes.GetNumberOfItems(), 1)
+            loaded = nodes.GetItemAsObject(0)
+            self.assertEqual((loaded.GetSeed(), loaded.GetMaximumBounces(), loaded.GetShadowExtinctionScale(),
+                              loaded.GetAccelerator(), loaded.GetSamplesPerRender(), loaded.GetMaximumSamples()),
+                             (11, 5, 1.0, display.Macrocell, 4, 8))
+            self.assertEqual(loaded.GetSegmentMaterialParameters("S_x=1;"), '{"roughness": 0.25}')
+            other = t.add_view()
+            other.render()
+            other.renderer.GetActiveCamera().DeepCopy(view.renderer.GetActiveCamera())
+            other.refine()
+            self.assertEqual(film(other.mapper()), first, "the same film after a save and a load")
+
+
+@NEEDS_PRESETS
+class RemovalTest(unittest.TestCase):
+    """Removing what a render uses while the image refines must not crash."""
+
+    def start(self):
+        s = SlicerScene()
+        view = s.add_view()
+        volume, display = head_ct(s, maximum_samples=64)
+        view.look_at_volume()
+        view.render()
+        self.assertFalse(view.mapper().IsConverged())
+        return s, view, volume, display
+
+    def test_remove_the_volume(self):
+        s, view, volume, display = self.start()
+        s.scene.RemoveNode(volume)
+        view.render()
+        view.render()
+        self.assertEqual(sum(covered(view.pixels())), 0)
+
+    def test_remove_the_display_node(self):
+        s, view, volume, display = self.start()
+        s.scene.RemoveNode(display)
+        view.render()
+        self.assertEqual(view.volumes("vtkMultiMaterialVolumeMapper"), [])
+
+    def test_remove_the_segmentation(self):
+        s, view, volume, display = self.start()
+        segmentation = s.scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "box")
+        segmentation.CreateDefaultDisplayNodes()
+        segmentation.SetReferenceImageGeometryParameterFromVolumeNode(volume)
+        segmentation.GetSegmentation().AddEmptySegment("box")
+        display.SetAndObserveSegmentationNodeID(segmentation.GetID())
+        view.render()
+        s.scene.RemoveNode(segmentation)
+        view.render()
+        view.render()
+        self.assertIsNone(display.GetSegmentationNode())
+
+    def test_remove_the_view(self):
+        s, view, volume, display = self.start()
+        s.scene.RemoveNode(view.node)
+        view.render()
+        view.group.SetMRMLDisplayableNode(None)
+        view.render()
+        s.scene.Clear(0)
+        view.render()
+
+
+if __name__ == "__main__":
+    unittest.main()
