@@ -5,13 +5,15 @@
 # same classes.
 
 #-----------------------------------------------------------------------------
-# Extension meta-information
-set(EXTENSION_HOMEPAGE "https://github.com/mmrtm/mmrtm/blob/main/Documentation/slicer.md")
+# Extension meta-information. The addresses are placeholders, as in Slicer's
+# template: set them to the project's public repository before submitting
+# the extension to the Slicer Extensions Index.
+set(EXTENSION_HOMEPAGE "https://www.example.com/mmrtm/Documentation/slicer.md")
 set(EXTENSION_CATEGORY "Rendering")
 set(EXTENSION_CONTRIBUTORS "MM-RTM developers")
 set(EXTENSION_DESCRIPTION "Physically based volume rendering (multi-material radiative transfer, Xu et al. 2025) as a rendering method of the Volume Rendering module: a path tracer that refines while the view is idle, with the Volume Rendering presets and a segmentation's segments as distinct materials.")
-set(EXTENSION_ICONURL "https://raw.githubusercontent.com/mmrtm/mmrtm/main/Documentation/images/default-render.png")
-set(EXTENSION_SCREENSHOTURLS "https://raw.githubusercontent.com/mmrtm/mmrtm/main/Documentation/images/slicer-ct-bone.png")
+set(EXTENSION_ICONURL "https://www.example.com/mmrtm/Documentation/images/default-render.png")
+set(EXTENSION_SCREENSHOTURLS "https://www.example.com/mmrtm/Documentation/images/slicer-head-ct-bone.png")
 set(EXTENSION_DEPENDS "SlicerLayerDisplayableManager")
 
 #-----------------------------------------------------------------------------

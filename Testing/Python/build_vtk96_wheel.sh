@@ -28,6 +28,12 @@ print("\n".join(sorted(names)))
 for pattern in (r"mmrtm/__init__\.py", r"mmrtm/mmrtmRendering\.cpython-.*\.so", r"mmrtm/mmrtmIO\.cpython-.*\.so",
                 r"mmrtm/libmmrtmRendering\.so", r"mmrtm/libmmrtmIO\.so", r"mmrtm/presets/ct-bone\.json"):
     assert any(re.fullmatch(pattern, n) for n in names), "the wheel lacks " + pattern
-assert not any(n.endswith((".h", ".cmake")) or re.search(r"\.so\.\d", n) for n in names), "headers or versioned libraries"
+assert not any(n.endswith((".h", ".cmake", ".a")) or re.search(r"\.so\.\d", n) for n in names), \
+    "headers, static or versioned libraries"
+# With slicer-core-sdk and slicer-layer-dm-sdk in the venv: the Slicer classes.
+kits = ("MRML", "Logic", "MRMLDisplayableManager")
+for pattern in (r"mmrtm_slicer/__init__\.py", r"slicer/slicer_mmrtm\.py") + tuple(
+        r"mmrtm_slicer/libvtkSlicerMultiMaterialVolumeRenderingModule%s\.so" % k for k in kits):
+    assert any(re.fullmatch(pattern, n) for n in names), "the wheel lacks " + pattern
 EOF
 "$venv/bin/python" -m pip install --no-deps --force-reinstall --disable-pip-version-check "${wheel[0]}"
