@@ -1,5 +1,6 @@
 """The mmrtm wheel in a fresh venv that has nothing but vtk==9.6.0 (and what
-pip brings with it) and the wheel: the package imports, reads a volume,
+pip brings with it) and the wheel: the package imports, reads volumes of
+each format the wheel reads (NRRD, NIfTI, MetaImage, VTK XML and legacy),
 finds its presets, and renders off screen.
 
 Run by ctest under xvfb-run after the test vtk96-wheel has built the wheel.
@@ -23,6 +24,12 @@ CHECK = textwrap.dedent("""
     from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
     import vtkmodules.vtkRenderingOpenGL2, vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401
     assert vtkVersion.GetVTKVersion() == "9.6.0", vtkVersion.GetVTKVersion()
+    # The readers of the wheel: NRRD, NIfTI, MetaImage, VTK XML and legacy VTK.
+    for name in ("mr_head.nii.gz", "frogtissue.mhd", "hydrogen.vti", "iron_protein.vtk"):
+        other = mmrtm.vtkMultiMaterialVolumeReader()
+        other.SetFileName(os.path.join(sys.argv[1], name))
+        other.Update()
+        assert other.GetOutput().GetNumberOfPoints() > 1000, name
     reader = mmrtm.vtkMultiMaterialVolumeReader()
     reader.SetFileName(os.path.join(sys.argv[1], "ct_head_headsq.nrrd"))
     reader.Update()
