@@ -20,40 +20,16 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from vtkmodules.vtkCommonCore import vtkVersion  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction  # noqa: E402
-from vtkmodules.vtkFiltersSources import vtkSphereSource  # noqa: E402
-from vtkmodules.vtkImagingCore import vtkImageThreshold  # noqa: E402
-from vtkmodules.vtkRenderingCore import vtkActor, vtkColorTransferFunction, vtkPolyDataMapper  # noqa: E402
 
 from test_mapper import Scene  # noqa: E402
 
 
 def add_labels_and_mesh(scene):
-    threshold = vtkImageThreshold()
-    threshold.SetInputConnection(scene.reader.GetOutputPort())
-    threshold.ThresholdByUpper(1500)
-    threshold.SetInValue(1)
-    threshold.SetOutValue(0)
-    threshold.SetOutputScalarTypeToUnsignedChar()
-    threshold.Update()
-    scene.mapper.SetMaskInput(threshold.GetOutput())
-    scene.mapper.SetMaskTypeToLabelMap()
-    blue = vtkColorTransferFunction()
-    blue.AddRGBPoint(0, 0.1, 0.2, 0.9)
-    scene.property.SetLabelColor(1, blue)
+    scene.keep = scene.add_bone_labels((0.1, 0.2, 0.9)), scene.add_sphere((1.0, 1.0, 1.0))
     edges = vtkPiecewiseFunction()
     edges.AddPoint(0, 0.2)
     edges.AddPoint(500, 1.0)
     scene.property.SetGradientOpacity(edges)
-    sphere = vtkSphereSource()
-    x, y, z = scene.reader.GetOutput().GetCenter()
-    sphere.SetCenter(x + 80, y, z)
-    sphere.SetRadius(45)
-    mapper = vtkPolyDataMapper()
-    mapper.SetInputConnection(sphere.GetOutputPort())
-    actor = vtkActor()
-    actor.SetMapper(mapper)
-    scene.renderer.AddActor(actor)
-    scene.keep = (threshold, actor)
 
 
 def main(name, out):

@@ -69,6 +69,39 @@ class Scene:
         self.renderer.GetActiveCamera().Elevation(-80)
         self.renderer.GetActiveCamera().OrthogonalizeViewUp()
 
+    def add_bone_labels(self, color):
+        """A label map on the CT's grid (label 1 where it is above 1500: the
+        bone) as the mapper's mask, label 1 coloured `color` (r, g, b).
+        Returns the threshold filter and the colour function."""
+        threshold = vtkImageThreshold()
+        threshold.SetInputConnection(self.reader.GetOutputPort())
+        threshold.ThresholdByUpper(1500)
+        threshold.SetInValue(1)
+        threshold.SetOutValue(0)
+        threshold.SetOutputScalarTypeToUnsignedChar()
+        threshold.Update()
+        self.mapper.SetMaskInput(threshold.GetOutput())
+        self.mapper.SetMaskTypeToLabelMap()
+        function = vtkColorTransferFunction()
+        function.AddRGBPoint(0, *color)
+        self.property.SetLabelColor(1, function)
+        return threshold, function
+
+    def add_sphere(self, color=(0.0, 1.0, 0.0)):
+        """An opaque sphere through the side of the head: partly outside the
+        skull, partly inside (hidden by the bone in front)."""
+        sphere = vtkSphereSource()
+        x, y, z = self.reader.GetOutput().GetCenter()
+        sphere.SetCenter(x + 80, y, z)
+        sphere.SetRadius(45)
+        mapper = vtkPolyDataMapper()
+        mapper.SetInputConnection(sphere.GetOutputPort())
+        actor = vtkActor()
+        actor.SetMapper(mapper)
+        actor.GetProperty().SetColor(*color)
+        self.renderer.AddActor(actor)
+        return actor
+
     def render(self):
         self.window.Render()
 
@@ -167,20 +200,9 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.counts(), (2, 2, 2))
 
     def test_label_function_edit_refits(self):
-        # A label map (label 1 where the CT is above 1500), coloured blue.
+        # The bone as label 1, coloured blue.
         s = Scene()
-        threshold = vtkImageThreshold()
-        threshold.SetInputConnection(s.reader.GetOutputPort())
-        threshold.ThresholdByUpper(1500)
-        threshold.SetInValue(1)
-        threshold.SetOutValue(0)
-        threshold.SetOutputScalarTypeToUnsignedChar()
-        threshold.Update()
-        s.mapper.SetMaskInput(threshold.GetOutput())
-        s.mapper.SetMaskTypeToLabelMap()
-        blue = vtkColorTransferFunction()
-        blue.AddRGBPoint(0, 0.1, 0.2, 0.9)
-        s.property.SetLabelColor(1, blue)
+        threshold, blue = s.add_bone_labels((0.1, 0.2, 0.9))
         s.render()
         s.render()
         self.assertEqual(s.counts(), (1, 1, 1))
@@ -200,18 +222,7 @@ class MapperTest(unittest.TestCase):
     def test_label_material_parameters(self):
         # The bone (label 1) as a glowing, purely volumetric material.
         s = Scene()
-        threshold = vtkImageThreshold()
-        threshold.SetInputConnection(s.reader.GetOutputPort())
-        threshold.ThresholdByUpper(1500)
-        threshold.SetInValue(1)
-        threshold.SetOutValue(0)
-        threshold.SetOutputScalarTypeToUnsignedChar()
-        threshold.Update()
-        s.mapper.SetMaskInput(threshold.GetOutput())
-        s.mapper.SetMaskTypeToLabelMap()
-        grey = vtkColorTransferFunction()
-        grey.AddRGBPoint(0, 0.5, 0.5, 0.5)
-        s.property.SetLabelColor(1, grey)
+        s.add_bone_labels((0.5, 0.5, 0.5))
         s.render()
         plain = s.pixels()
         s.mapper.SetLabelMaterialParameters(1, '{"emission": [0, 4, 0], "surface_probability": 0}')
@@ -237,18 +248,7 @@ class MapperTest(unittest.TestCase):
     def test_opaque_geometry_hides_and_moving_it_restarts(self):
         s = Scene()
         s.render()
-        # A green sphere through the side of the head: partly outside the
-        # skull (visible), partly inside (hidden by the bone in front).
-        sphere = vtkSphereSource()
-        x, y, z = s.reader.GetOutput().GetCenter()
-        sphere.SetCenter(x + 80, y, z)
-        sphere.SetRadius(45)
-        mapper = vtkPolyDataMapper()
-        mapper.SetInputConnection(sphere.GetOutputPort())
-        actor = vtkActor()
-        actor.SetMapper(mapper)
-        actor.GetProperty().SetColor(0.0, 1.0, 0.0)
-        s.renderer.AddActor(actor)
+        actor = s.add_sphere()  # green
         s.render()
         self.assertEqual(s.counts(), (1, 1, 2), "new geometry: a restart")
 
