@@ -337,10 +337,23 @@ class MapperTest(unittest.TestCase):
         self.assertGreater(mean_abs_difference(before, after), 0.005, "the preset's materials and lights show")
         s.render()
         self.assertEqual(s.counts(), (builds, refits, restarts), "unchanged description: samples accumulate")
+        # An edit of the description over the same data: a refit that keeps
+        # the majorant grid's summaries, not a rebuild.
+        grids = s.mapper.GetNumberOfMajorantGridBuilds()
+        self.assertGreaterEqual(grids, 1)
         materials.MergeSceneJSON('{"materials": {"bone": {"albedo": [0.2, 0.3, 0.9]}}}')
         s.render()
-        self.assertEqual(s.counts()[0], builds + 1)
-        self.assertGreater(mean_abs_difference(after, s.pixels()), 0.005)
+        self.assertEqual(s.counts(), (builds, refits + 1, restarts + 1))
+        self.assertEqual(s.mapper.GetNumberOfMajorantGridBuilds(), grids, "the summaries were kept")
+        edited = s.pixels()
+        self.assertGreater(mean_abs_difference(after, edited), 0.005)
+        # The refitted scene renders as a scene built from scratch would.
+        fresh = Scene()
+        fresh_materials = vtkMultiMaterialProperty()
+        fresh_materials.SetSceneJSON(materials.GetSceneJSON())
+        fresh.mapper.SetMultiMaterialProperty(fresh_materials)
+        fresh.render()
+        self.assertEqual(fresh.pixels(), edited)
 
     def test_environment_texture_lights_the_volume(self):
         s = Scene()

@@ -84,7 +84,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::vector<float> Depth;  // the depth buffer under the volume at the last restart
   bool HasScene = false, Warned = false;
 
-  int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0;
+  int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0;
   // While the interactor moves the camera: a preview at 1/PreviewFactor of
   // the resolution, 1 sample per pixel, the factor adapted to the frame rate.
   std::unique_ptr<mmrtm::Film> Preview;
@@ -257,6 +257,7 @@ void vtkMultiMaterialVolumeMapper::SetMultiMaterialProperty(vtkMultiMaterialProp
   {
     this->Internal->MultiMaterial = property;
     this->Internal->MultiMaterialTime = 0;
+    this->Internal->HasScene = false;  // another source of materials: the proxies are made again
     this->Modified();
   }
 }
@@ -375,6 +376,11 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfSceneBuilds()
   return this->Internal->SceneBuilds;
 }
 
+int vtkMultiMaterialVolumeMapper::GetNumberOfMajorantGridBuilds()
+{
+  return this->Internal->GridBuilds;
+}
+
 int vtkMultiMaterialVolumeMapper::GetNumberOfRefits()
 {
   return this->Internal->Refits;
@@ -451,12 +457,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       componentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
     vtkMultiMaterialProperty* multi = in.MultiMaterial;
     const vtkMTimeType multiTime = multi ? multi->GetMTime() : 0;
-    if (multi && multiTime != in.MultiMaterialTime)
-    {
-      // A new description: the scene is parsed again, with its proxies.
-      in.MultiMaterialTime = multiTime;
-      in.HasScene = false;
-    }
+    // An edited description over unchanged data is parsed again over the
+    // proxies as they are, and refits (below).
+    const bool newDescription = multi && multiTime != in.MultiMaterialTime;
+    in.MultiMaterialTime = multiTime;
     if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
       this->MaskType != in.MaskTypeBuilt || (!multi && needGradient != (in.Layout.gradient >= 0)) ||
       dependent != in.DependentBuilt || independent != in.IndependentBuilt ||
@@ -489,6 +493,11 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.ComponentGradientsBuilt = componentGradients;
       in.PropertyTime = 0;  // translate the property again
       ++in.SceneBuilds;
+      restart = true;
+    }
+    else if (newDescription)
+    {
+      this->ReparseMultiMaterialScene();
       restart = true;
     }
 
@@ -579,6 +588,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     }
     in.Preview.reset();
     const mmrtm::SceneView sceneView = in.Scene.Build();
+    in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
     const int accumulated = static_cast<int>(in.Film->Samples());
     const int samples = this->IsConverged() ? 0
       : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
@@ -743,6 +753,37 @@ void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
   in.Layout = mmrtm::ProxyLayout();
   in.PropertyTime = 0;
   ++in.Refits;
+}
+
+void vtkMultiMaterialVolumeMapper::ReparseMultiMaterialScene()
+{
+  // The description is parsed over the proxies of the last build (the
+  // input and the mask, moved with their buffers and given back their own
+  // index-to-world: the volume's matrix is applied at the restart). The
+  // grid's summaries go over to the new scene when its proxies are those
+  // very buffers, so that the edit costs a refit.
+  Internals& in = *this->Internal;
+  in.HasScene = false;  // until the parse succeeds; after a failure the input is read again
+  mmrtm::Scene previous = std::move(in.Scene);
+  in.Scene = mmrtm::Scene();
+  in.Layout = mmrtm::ProxyLayout();
+  const int labels = previous.ProxyIndex("labels");
+  for (const int i : { 0, labels })
+  {
+    if (i < 0 || i >= static_cast<int>(previous.proxies.size()))
+      continue;
+    mmrtm::HostVolume volume = std::move(previous.proxies[i]);
+    volume.indexToWorld = in.ImageIndexToWorld.at(i);
+    if (i == labels)
+      in.Layout.labels = static_cast<int>(in.Scene.proxies.size());
+    in.Scene.proxies.push_back(std::move(volume));
+  }
+  this->ParseMultiMaterialScene();
+  in.Scene.AdoptDataSummariesFrom(previous);
+  in.ImageIndexToWorld.clear();
+  for (const mmrtm::HostVolume& v : in.Scene.proxies)
+    in.ImageIndexToWorld.push_back(v.indexToWorld);
+  in.HasScene = true;
 }
 
 std::vector<mmrtm::ClipPlane> vtkMultiMaterialVolumeMapper::ClipPlanes(vtkVolume* vol)

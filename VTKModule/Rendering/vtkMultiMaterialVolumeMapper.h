@@ -288,6 +288,13 @@ public:
   ///@}
 
   /**
+   * How often the majorant grid's per-voxel summaries were built (the
+   * costly part of a scene build; a refit does not build them). An edited
+   * vtkMultiMaterialProperty over unchanged data reuses them.
+   */
+  int GetNumberOfMajorantGridBuilds();
+
+  /**
    * Description of the backend in use ("cpu, 2 thread(s)"), after a render.
    */
   const char* GetBackendDescription();
@@ -319,6 +326,7 @@ private:
   void Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
+  void ReparseMultiMaterialScene();
   void UpdateEnvironment();
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);

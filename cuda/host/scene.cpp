@@ -156,6 +156,19 @@ CameraView Scene::BuildCamera() const {
   return v;
 }
 
+bool Scene::AdoptDataSummariesFrom(Scene& previous) {
+  if (previous.dataModified_ || !previous.modifiedRegions_.empty() ||
+      previous.summarisedVoxels_.size() != proxies.size())
+    return false;
+  for (size_t i = 0; i < proxies.size(); ++i)
+    if (proxies[i].voxels.data() != previous.summarisedVoxels_[i]) return false;
+  grid_ = std::move(previous.grid_);
+  valueRanges_ = previous.valueRanges_;
+  summarisedVoxels_ = previous.summarisedVoxels_;
+  dataModified_ = false;
+  return true;
+}
+
 SceneView Scene::Build() {
   Validate();
   // What depends on the voxels alone is checked and measured once per data
@@ -163,9 +176,11 @@ SceneView Scene::Build() {
   dataModified_ = dataModified_ || valueRanges_.size() != proxies.size();
   if (dataModified_ || !modifiedRegions_.empty()) {
     valueRanges_.clear();
+    summarisedVoxels_.clear();
     for (const HostVolume& v : proxies) {
       v.Validate();
       valueRanges_.push_back(v.ValueRange());
+      summarisedVoxels_.push_back(v.voxels.data());
     }
   }
 
@@ -258,11 +273,13 @@ SceneView Scene::Build() {
   const AcceleratorSettings& acc = render.accelerator;
   s.majorants.kind = acc.kind;
   s.majorants.globalMajorant = GlobalMajorant();
+  gridBuilt_ = false;
   if (acc.kind != MajorantKind::Global) {
     const MajorantGridOptions& o = acc.grid;
     const bool layoutChanged = grid_ && (grid_->Options().leafLevel != o.leafLevel ||
                                          grid_->Options().margin != o.margin || grid_->Options().summary != o.summary);
-    if (!grid_ || dataModified_ || layoutChanged) {
+    gridBuilt_ = !grid_ || dataModified_ || layoutChanged;
+    if (gridBuilt_) {
       if (!grid_) grid_ = std::make_unique<MajorantGrid>();
       grid_->Build(proxies, o);
     } else {

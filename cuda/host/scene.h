@@ -124,6 +124,16 @@ class Scene {
   void MarkRegionModified(std::array<int, 3> lo, std::array<int, 3> hi) { modifiedRegions_.push_back({lo, hi}); }
   // The majorant grid of the last Build (null with the global majorant).
   const MajorantGrid* Grid() const { return grid_.get(); }
+  // Whether the last Build built the grid's summaries (not only a refit).
+  bool GridSummariesBuiltByLastBuild() const { return gridBuilt_; }
+
+  // A scene built anew from a description over the same voxels (a TF or
+  // material edit in a scene file, the proxies moved over from `previous`)
+  // takes `previous`'s per-voxel work: the majorant grid's summaries and the
+  // value ranges. Then its next Build is a refit, not a rebuild. Nothing is
+  // taken unless every proxy is the very buffer `previous` last built from.
+  // Returns whether it was taken.
+  bool AdoptDataSummariesFrom(Scene& previous);
 
  private:
   void Validate() const;
@@ -137,7 +147,9 @@ class Scene {
   std::vector<Light> lightViews_;
   std::unique_ptr<MajorantGrid> grid_;
   std::vector<std::array<float, 2>> valueRanges_;  // per proxy, at the last data load
+  std::vector<const uint8_t*> summarisedVoxels_;    // per proxy, the buffers of the last data load
   bool dataModified_ = true;
+  bool gridBuilt_ = false;
   std::vector<std::array<std::array<int, 3>, 2>> modifiedRegions_;
 };
 
