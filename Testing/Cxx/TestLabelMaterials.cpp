@@ -54,6 +54,27 @@ TEST(LabelMaterials, OneMaterialPerLabelFirstMatchingClassWins) {
   EXPECT_EQ(doc["material_tfs"][1]["type"], "mpctf");
 }
 
+TEST(LabelMaterials, AClassByIdWinsOverTheNamesAfterIt) {
+  // The viewer edits one label as a class of its own, put first.
+  json doc = Classes();
+  doc["label_materials"]["classes"].insert(doc["label_materials"]["classes"].begin(),
+                                           json::parse(R"({"ids": [3], "color": "material",
+                                             "material": {"density": 0.5, "albedo": [0, 0, 1], "roughness": 0.2}})"));
+  const LabelTable table = Table();
+  const json expanded = ExpandLabelMaterials(doc, {1, 2, 3}, &table);
+  EXPECT_EQ(expanded["materials"]["liver"]["density"], 0.5);
+  EXPECT_EQ(expanded["materials"]["liver"]["albedo"], json({0, 0, 1}));
+  EXPECT_EQ(expanded["materials"]["aorta"]["density"], 4);  // the others as before
+  json bad = Classes();
+  bad["label_materials"]["classes"][0] = json::parse(R"({"ids": [1.5], "material": {}})");
+  try {
+    ExpandLabelMaterials(bad, {1}, &table);
+    FAIL() << "a fractional id must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("label_materials.classes[0].ids"), std::string::npos) << e.what();
+  }
+}
+
 TEST(LabelMaterials, UnmatchedLabelsStayUnclaimed) {
   json doc = Classes();
   doc["label_materials"]["classes"].erase(2);  // no "*"

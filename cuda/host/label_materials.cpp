@@ -33,6 +33,7 @@ void CollectIds(const T* v, int64_t n, std::set<int>& ids, const HostVolume& lab
 
 struct LabelClass {
   std::vector<std::string> match;  // lower case
+  std::vector<int> ids;            // exact label ids
   json material;
   bool colorFromTable = true;
 };
@@ -46,14 +47,25 @@ std::vector<LabelClass> ParseClasses(const json& block) {
     const json& c = block["classes"][i];
     if (!c.is_object()) Fail(where, "expected an object");
     for (auto it = c.begin(); it != c.end(); ++it)
-      if (it.key() != "match" && it.key() != "material" && it.key() != "color")
-        Fail(where, "unknown key '" + it.key() + "' (known: match, material, color)");
+      if (it.key() != "match" && it.key() != "ids" && it.key() != "material" && it.key() != "color")
+        Fail(where, "unknown key '" + it.key() + "' (known: match, ids, material, color)");
     LabelClass lc;
-    if (!c.contains("match") || !c["match"].is_array() || c["match"].empty())
-      Fail(where + ".match", "expected a list of name fragments (\"*\" matches every label)");
-    for (const json& m : c["match"]) {
-      if (!m.is_string() || m.get<std::string>().empty()) Fail(where + ".match", "expected non-empty strings");
-      lc.match.push_back(Lower(m.get<std::string>()));
+    if (!c.contains("match") && !c.contains("ids"))
+      Fail(where, "expected \"match\" (name fragments) or \"ids\" (label ids)");
+    if (c.contains("match")) {
+      if (!c["match"].is_array() || c["match"].empty())
+        Fail(where + ".match", "expected a list of name fragments (\"*\" matches every label)");
+      for (const json& m : c["match"]) {
+        if (!m.is_string() || m.get<std::string>().empty()) Fail(where + ".match", "expected non-empty strings");
+        lc.match.push_back(Lower(m.get<std::string>()));
+      }
+    }
+    if (c.contains("ids")) {
+      if (!c["ids"].is_array() || c["ids"].empty()) Fail(where + ".ids", "expected a list of label ids");
+      for (const json& id : c["ids"]) {
+        if (!id.is_number_integer()) Fail(where + ".ids", "expected integer label ids");
+        lc.ids.push_back(id.get<int>());
+      }
     }
     lc.material = c.value("material", json::object());
     if (!lc.material.is_object()) Fail(where + ".material", "expected a material object");
@@ -66,11 +78,13 @@ std::vector<LabelClass> ParseClasses(const json& block) {
   return classes;
 }
 
-const LabelClass* MatchClass(const std::vector<LabelClass>& classes, const std::string& name) {
+const LabelClass* MatchClass(const std::vector<LabelClass>& classes, int id, const std::string& name) {
   const std::string lower = Lower(name);
-  for (const LabelClass& c : classes)
+  for (const LabelClass& c : classes) {
+    if (std::find(c.ids.begin(), c.ids.end(), id) != c.ids.end()) return &c;
     for (const std::string& m : c.match)
       if (m == "*" || lower.find(m) != std::string::npos) return &c;
+  }
   return nullptr;
 }
 
@@ -105,7 +119,7 @@ json ExpandLabelMaterials(json doc, const std::vector<int>& ids, const LabelTabl
   for (int id : ids) {
     const LabelEntry* entry = table ? table->Find(id) : nullptr;
     std::string name = entry ? entry->name : "label_" + std::to_string(id);
-    const LabelClass* c = MatchClass(classes, name);
+    const LabelClass* c = MatchClass(classes, id, name);
     if (!c) continue;
     while (doc["materials"].contains(name)) name += "_" + std::to_string(id);  // keep the scene's own materials
     json material = c->material;

@@ -24,6 +24,7 @@ std::vector<int> LabelIdsPresent(const HostVolume& labels);
 //     "proxy": "labels",                       // the label map (default "labels")
 //     "classes": [                             // first match wins
 //       {"match": ["artery", "aorta"],         // substrings of the label name, case-insensitive; "*" matches all
+//        "ids": [5, 6],                        // and/or exact label ids
 //        "material": {...},                    // a material as in "materials" (without "tfs")
 //        "color": "table" | "material"}        // albedo from the label table (default), or the material's own
 //     ]
