@@ -9,6 +9,7 @@ packages=(
   libinsighttoolkit5-dev   # DICOM through ITK + GDCM (JPEG 2000 included)
   python3-dev              # the Python wrapping of the VTK module
   xvfb xauth
+  qt6-base-dev libqt6opengl6-dev libqt6openglwidgets6 libxkbcommon-dev   # the Qt 6 viewer
   ninja-build              # the VTK 9.6 SDK and the wheel build (scripts/make-vtk-sdk.sh)
   python3-venv             # .venv: Mitsuba 3, numpy, matplotlib (accuracy checks and charts)
   invesalius-examples   # the default input: Cranium.inv3

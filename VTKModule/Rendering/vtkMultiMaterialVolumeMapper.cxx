@@ -85,6 +85,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   bool HasScene = false, Warned = false;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0;
+  double LastBuildSeconds = 0;
   // While the interactor moves the camera: a preview at 1/PreviewFactor of
   // the resolution, 1 sample per pixel, the factor adapted to the frame rate.
   std::unique_ptr<mmrtm::Film> Preview;
@@ -376,6 +377,11 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfSceneBuilds()
   return this->Internal->SceneBuilds;
 }
 
+double vtkMultiMaterialVolumeMapper::GetLastRefitSeconds()
+{
+  return this->Internal->LastBuildSeconds;
+}
+
 int vtkMultiMaterialVolumeMapper::GetNumberOfMajorantGridBuilds()
 {
   return this->Internal->GridBuilds;
@@ -587,8 +593,11 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       return;
     }
     in.Preview.reset();
+    const auto buildStart = std::chrono::steady_clock::now();
     const mmrtm::SceneView sceneView = in.Scene.Build();
     in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
+    if (restart)  // the build after a change: a refit (or the summaries and a refit)
+      in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
     const int accumulated = static_cast<int>(in.Film->Samples());
     const int samples = this->IsConverged() ? 0
       : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)

@@ -295,6 +295,13 @@ public:
   int GetNumberOfMajorantGridBuilds();
 
   /**
+   * Seconds the scene's build took at the last restart: the refit of the
+   * majorants after a transfer-function change (with the grid's summaries
+   * after a data change). For status lines and benchmarks.
+   */
+  double GetLastRefitSeconds();
+
+  /**
    * Description of the backend in use ("cpu, 2 thread(s)"), after a render.
    */
   const char* GetBackendDescription();

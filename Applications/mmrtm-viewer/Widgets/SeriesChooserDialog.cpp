@@ -33,9 +33,9 @@ void SeriesChooserDialog::choose(int row) {
   if (row >= 0 && row < list_->topLevelItemCount()) list_->setCurrentItem(list_->topLevelItem(row));
 }
 
-QString SeriesChooserDialog::chosenUid() const {
+QString SeriesChooserDialog::chosenKey() const {
   const int row = list_->indexOfTopLevelItem(list_->currentItem());
-  return row >= 0 ? series_[row].uid : QString();
+  return row >= 0 ? series_[row].key() : QString();
 }
 
 }  // namespace mmrtm::viewer

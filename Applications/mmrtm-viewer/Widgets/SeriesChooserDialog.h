@@ -13,6 +13,9 @@ namespace mmrtm::viewer {
 struct SeriesInfo {
   QString uid, description, modality;
   int slices = 0, rows = 0, columns = 0;
+  // What names the series to the reader: its UID, or its description when
+  // the files carry no UID.
+  QString key() const { return uid.isEmpty() ? description : uid; }
 };
 
 class SeriesChooserDialog : public QDialog {
@@ -20,8 +23,8 @@ class SeriesChooserDialog : public QDialog {
 
  public:
   SeriesChooserDialog(const QString& folder, const QVector<SeriesInfo>& series, QWidget* parent = nullptr);
-  // The chosen series' UID (the first row is selected at the start).
-  QString chosenUid() const;
+  // The chosen series' key (the first row is selected at the start).
+  QString chosenKey() const;
   // Selects a row (tests).
   void choose(int row);
 

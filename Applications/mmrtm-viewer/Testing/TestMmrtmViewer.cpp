@@ -1,0 +1,298 @@
+// QTest of mmrtm-viewer, run under Xvfb (the xcb platform: Qt 6.4's
+// offscreen platform has no QOpenGLWidget): the window as a user drives it,
+// with the mouse on the transfer-function editor and the label table, and
+// the files of ../shared/data.
+#include <QApplication>
+#include <QDir>
+#include <QFile>
+#include <QImage>
+#include <QJsonDocument>
+#include <QLabel>
+#include <QProcess>
+#include <QSurfaceFormat>
+#include <QTemporaryDir>
+#include <QtTest>
+
+#include <vtkCamera.h>
+#include <vtkFloatArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkImageData.h>
+#include <vtkPointData.h>
+#include <vtkRenderer.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "LabelTableWidget.h"
+#include "MainWindow.h"
+#include "RenderSettingsWidget.h"
+#include "TransferFunctionEditor.h"
+#include "VtkOpenGLWidget.h"
+#include "image_io.h"
+#include "vtkMultiMaterialVolumeMapper.h"
+
+namespace fs = std::filesystem;
+using mmrtm::viewer::MainWindow;
+
+namespace {
+QString Data(const char* name) { return QString(MMRTM_SHARED_DATA_DIR) + "/" + name; }
+
+// Processes events (the window refines by itself) until the image has
+// `samples` samples per pixel.
+bool RefineTo(MainWindow& w, int samples, int timeoutMs = 120000) {
+  return QTest::qWaitFor([&] { return w.scene().Mapper()->GetAccumulatedSamples() >= samples; }, timeoutMs);
+}
+
+// The view's pixels as the user sees them.
+QImage View(MainWindow& w) { return w.view()->grabFramebuffer().convertToFormat(QImage::Format_RGB888); }
+
+double Coverage(const QImage& image) {
+  // Pixels that differ from the view's background (0.08, 0.08, 0.1).
+  int covered = 0;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const QColor c = image.pixelColor(x, y);
+      covered += std::abs(c.red() - 20) + std::abs(c.green() - 20) + std::abs(c.blue() - 26) > 30;
+    }
+  return double(covered) / (image.width() * image.height());
+}
+
+double MeanDifference(const QImage& a, const QImage& b) {
+  double sum = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) {
+      const QColor p = a.pixelColor(x, y), q = b.pixelColor(x, y);
+      sum += std::abs(p.red() - q.red()) + std::abs(p.green() - q.green()) + std::abs(p.blue() - q.blue());
+    }
+  return sum / (3.0 * 255 * a.width() * a.height());
+}
+
+// A window of a fixed size with fast settings: the same seed every time.
+struct Viewer {
+  MainWindow window;
+  QString error;
+  Viewer() {
+    window.setErrorHandler([this](const QString& message) { error = message; });
+    window.resize(1000, 640);
+    window.show();
+    mmrtm::viewer::RenderSettings s = window.renderSettings()->settings();
+    s.samplesPerRender = 2;
+    s.maximumSamples = 8;
+    window.renderSettings()->setSettings(s);
+    window.scene().SetSettings(s);
+    exposed = QTest::qWaitForWindowExposed(&window);
+  }
+  bool exposed = false;
+};
+}  // namespace
+
+class TestMmrtmViewer : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void opensTheHeadCtAndShowsAnImage() {
+    Viewer v;
+    QVERIFY(v.exposed);
+    QElapsedTimer timer;
+    timer.start();
+    QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
+    QVERIFY2(v.error.isEmpty(), qPrintable(v.error));
+    QVERIFY(RefineTo(v.window, 8, 60000));
+    const double coverage = Coverage(View(v.window));
+    qInfo("head CT: 8 samples per pixel after %lld ms; coverage %.3f", timer.elapsed(), coverage);
+    QVERIFY2(coverage > 0.05 && coverage < 0.9, "a blank or full view");
+    QVERIFY(v.window.statusLine()->text().contains("8 samples/pixel"));
+  }
+
+  void draggingAPointRefitsRestartsAndReleaseRefines() {
+    Viewer v;
+    QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
+    QVERIFY(RefineTo(v.window, 8));
+    const QImage before = View(v.window);
+    vtkMultiMaterialVolumeMapper* m = v.window.scene().Mapper();
+    const int refits = m->GetNumberOfRefits(), grids = m->GetNumberOfMajorantGridBuilds();
+    mmrtm::viewer::TransferFunctionEditor* editor = v.window.transferFunctionEditor();
+    // The ct-bone density curve's middle point, dragged to the right (less bone).
+    QCOMPARE(editor->points().size(), 3);
+    const QPoint from = editor->pointPosition(1);
+    QTest::mousePress(editor, Qt::LeftButton, {}, from);
+    QTest::mouseMove(editor, from + QPoint(40, 0));
+    QCOMPARE(editor->points()[1].x() > 300, true);
+    QTest::qWait(300);  // the preview renders while the button is held
+    QVERIFY2(m->GetNumberOfRefits() > refits, "dragging refits");
+    QCOMPARE(m->GetAccumulatedSamples(), 0);  // previews do not accumulate
+    QTest::mouseRelease(editor, Qt::LeftButton, {}, from + QPoint(40, 0));
+    QVERIFY(RefineTo(v.window, 8));
+    QCOMPARE(m->GetNumberOfMajorantGridBuilds(), grids);  // refits only: the summaries were kept
+    QVERIFY2(MeanDifference(before, View(v.window)) > 0.002, "the image changed");
+  }
+
+  void hidingALabelChangesItsPixelsOnly() {
+    Viewer v;
+    QVERIFY(v.window.setPreset("ct-organs"));
+    QVERIFY(v.window.openVolume(Data("ct_abdomen.nii.gz")));
+    QVERIFY(v.window.openLabels(Data("ct_abdomen_labels.nii.gz")));
+    QVERIFY(v.window.openLabelTable(Data("ct_abdomen_labels.txt")));
+    QVERIFY2(v.error.isEmpty(), qPrintable(v.error));
+    mmrtm::viewer::LabelTableWidget* table = v.window.labelTable();
+    int liver = -1;
+    for (int row = 0; row < table->labels().size(); ++row)
+      if (table->labels()[row].name == "liver") liver = row;
+    QVERIFY(liver >= 0);
+    mmrtm::viewer::LabelEntry entry = table->labels()[liver];
+    entry.color = QColor(0, 0, 255);
+    table->setLabel(liver, entry);
+    QVERIFY(RefineTo(v.window, 8));
+    const QImage before = View(v.window);
+    entry.visible = false;
+    table->setLabel(liver, entry);
+    QTest::qWait(50);
+    QVERIFY(RefineTo(v.window, 8));
+    const QImage after = View(v.window);
+    // The liver's pixels (blue before) change; the others, far from it, do not.
+    int blue = 0, blueChanged = 0, others = 0, othersChanged = 0;
+    for (int y = 2; y < before.height() - 2; ++y)
+      for (int x = 2; x < before.width() - 2; ++x) {
+        bool nearBlue = false;
+        for (int dy = -2; dy <= 2 && !nearBlue; ++dy)
+          for (int dx = -2; dx <= 2 && !nearBlue; ++dx) {
+            const QColor c = before.pixelColor(x + dx, y + dy);
+            nearBlue = c.blue() > c.red() + 30 && c.blue() > c.green() + 30;
+          }
+        const QColor p = before.pixelColor(x, y), q = after.pixelColor(x, y);
+        const bool changed = std::abs(p.red() - q.red()) + std::abs(p.green() - q.green()) + std::abs(p.blue() - q.blue()) > 24;
+        const QColor c = p;
+        if (c.blue() > c.red() + 30 && c.blue() > c.green() + 30) {
+          ++blue;
+          blueChanged += changed;
+        } else if (!nearBlue) {
+          ++others;
+          othersChanged += changed;
+        }
+      }
+    qInfo("liver pixels %d (%d changed), other pixels %d (%d changed)", blue, blueChanged, others, othersChanged);
+    QVERIFY2(blue > 200, "the blue liver shows");
+    QVERIFY2(blueChanged > 0.8 * blue, "hidden: the liver's pixels change");
+    QVERIFY2(othersChanged < 0.05 * others, "the other pixels do not");
+  }
+
+  void aFolderWithTwoSeriesOpensTheChooser() {
+    // Two series in one folder: the chest series, and the abdomen's JPEG 2000 one.
+    QTemporaryDir folder;
+    for (const auto& source : {Data("ct_chest_dicom"), Data("ct_abdomen_dicom_j2k")})
+      for (const auto& entry : fs::directory_iterator(source.toStdString()))
+        fs::copy_file(entry.path(), fs::path(folder.path().toStdString()) /
+                                        (QFileInfo(source).fileName().toStdString() + "_" + entry.path().filename().string()));
+    Viewer v;
+    QVector<mmrtm::viewer::SeriesInfo> offered;
+    v.window.setSeriesChooser([&](const QString&, const QVector<mmrtm::viewer::SeriesInfo>& series) {
+      offered = series;
+      for (const auto& s : series)
+        if (s.slices == 20) return s.key();  // the abdomen's 20 slices
+      return QString();
+    });
+    QVERIFY2(v.window.openVolume(folder.path()), qPrintable(v.error));
+    QCOMPARE(offered.size(), 2);
+    int dims[3];
+    vtkImageData::SafeDownCast(v.window.scene().Mapper()->GetInput())->GetDimensions(dims);
+    QCOMPARE(dims[2], 20);
+    QVERIFY2(v.error.isEmpty(), qPrintable(v.error));
+    // The real chooser lists both and returns the chosen series' key.
+    mmrtm::viewer::SeriesChooserDialog dialog(folder.path(), offered);
+    dialog.choose(1);
+    QCOMPARE(dialog.chosenKey(), offered[1].key());
+  }
+
+  void aBrokenFileShowsTheErrorAndKeepsTheVolume() {
+    Viewer v;
+    QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
+    QVERIFY(RefineTo(v.window, 4));
+    QTemporaryDir folder;
+    const QString broken = folder.filePath("broken.nrrd");
+    QFile source(Data("ct_head_cranium.nrrd"));
+    QVERIFY(source.open(QIODevice::ReadOnly));
+    QFile out(broken);
+    QVERIFY(out.open(QIODevice::WriteOnly));
+    out.write(source.read(4096));  // the header and a sliver of the data
+    out.close();
+    QVERIFY(!v.window.openVolume(broken));
+    QVERIFY2(v.error.contains("broken.nrrd"), qPrintable(v.error));
+    QVERIFY(v.window.scene().VolumePath().find("ct_head_cranium.nrrd") != std::string::npos);
+    v.error.clear();
+    // A label map far from the volume (4 x 4 x 4 voxels 10 m away).
+    const QString far = folder.filePath("far_labels.nrrd");
+    QFile labels(far);
+    QVERIFY(labels.open(QIODevice::WriteOnly));
+    labels.write("NRRD0004\ntype: uchar\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 4 4\n"
+                 "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (10000,10000,10000)\n"
+                 "encoding: raw\n\n");
+    labels.write(QByteArray(64, 1));
+    labels.close();
+    QVERIFY(!v.window.openLabels(far));
+    QVERIFY2(v.error.contains("does not overlap"), qPrintable(v.error));
+    QVERIFY(!v.window.loadScene(folder.filePath("missing.json")));
+    QVERIFY(RefineTo(v.window, 8));  // the head CT still renders
+  }
+
+  void aSavedSceneRendersTheSameInMmrtmRender() {
+    Viewer v;
+    QVERIFY(v.window.openVolume(Data("ct_head_headsq.nrrd")));
+    QVERIFY(v.window.setPreset("ct-bone"));
+    QVERIFY(RefineTo(v.window, 8));
+    QTemporaryDir folder;
+    const QString scene = folder.filePath("scene.json"), viewer = folder.filePath("viewer.pfm"),
+                  rendered = folder.filePath("render.pfm");
+    QVERIFY(v.window.saveScene(scene));
+    QVERIFY(v.window.saveLinearImage(viewer));
+    QProcess render;
+    render.start(MMRTM_RENDER, {"--scene", scene, "--output", folder.filePath("render.png"), "--output-linear",
+                                rendered, "--backend", "cpu"});
+    QVERIFY(render.waitForFinished(120000));
+    QVERIFY2(render.exitCode() == 0, render.readAllStandardError().constData());
+    const mmrtm::RGBImage a = mmrtm::ReadPFM(viewer.toStdString()), b = mmrtm::ReadPFM(rendered.toStdString());
+    QCOMPARE(a.width, b.width);
+    QCOMPARE(a.height, b.height);
+    size_t differing = 0;
+    double lit = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) differing += a.pixels[i][c] != b.pixels[i][c];
+      lit += a.pixels[i][1] > 0.01;
+    }
+    qInfo("viewer vs mmrtm-render: %zu of %zu values differ; %.0f lit pixels", differing, 3 * a.pixels.size(), lit);
+    QVERIFY2(lit > 0.05 * a.pixels.size(), "an empty render");
+    QCOMPARE(differing, size_t(0));
+  }
+
+  void windowScreenshotMatchesTheBaseline() {
+    Viewer v;
+    QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
+    QVERIFY(RefineTo(v.window, 8));
+    QTest::qWait(100);
+    const QImage window = v.window.grab().toImage().convertToFormat(QImage::Format_RGB888);
+    const QString temporary = QString(MMRTM_TEST_OUTPUT_DIR) + "/mmrtm-viewer-window.png";
+    window.save(temporary);
+    const QImage baseline = QImage(QString(MMRTM_DATA_DIR) + "/Baselines/Viewer/mmrtm-viewer-window.png")
+                                .convertToFormat(QImage::Format_RGB888);
+    QVERIFY2(!baseline.isNull(), "no baseline (the test wrote the window to Testing/Output)");
+    QCOMPARE(window.size(), baseline.size());
+    // The 3D view exactly (one seed, one sample count); the rest (fonts,
+    // widget styles) at 1/8 of the size, within 6 %.
+    const QRect view(v.window.view()->mapTo(&v.window, QPoint(0, 0)), v.window.view()->size());
+    const double viewDifference = MeanDifference(window.copy(view), baseline.copy(view));
+    const auto coarse = [](const QImage& i) { return i.scaled(i.size() / 8, Qt::IgnoreAspectRatio, Qt::SmoothTransformation); };
+    const double windowDifference = MeanDifference(coarse(window), coarse(baseline));
+    qInfo("view differs by %.4f, window (1/8 size) by %.4f; image in %s", viewDifference, windowDifference,
+          qPrintable(temporary));
+    QVERIFY(viewDifference < 0.01);
+    QVERIFY(windowDifference < 0.06);
+  }
+};
+
+int main(int argc, char** argv) {
+  QSurfaceFormat::setDefaultFormat(mmrtm::viewer::VtkOpenGLWidget::DefaultFormat());
+  QApplication app(argc, argv);
+  TestMmrtmViewer test;
+  return QTest::qExec(&test, argc, argv);
+}
+
+#include "TestMmrtmViewer.moc"
