@@ -45,7 +45,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), scene_(std::make_
   view_ = new VtkOpenGLWidget;
   setCentralWidget(view_);
 
-  auto* tabs = new QTabWidget;
+  auto* tabs = tabs_ = new QTabWidget;
   tabs->addTab(buildMaterialsPanel(), tr("Materials"));
   labels_ = new LabelTableWidget;
   tabs->addTab(labels_, tr("Labels"));
@@ -360,6 +360,11 @@ void MainWindow::updateStatus() {
                        .arg(m->GetLastRefitSeconds() * 1000, 0, 'f', 1)
                        .arg(QString::fromUtf8(m->GetBackendDescription()))
                        .arg(m->IsConverged() ? tr("   (converged)") : QString()));
+}
+
+void MainWindow::showEditor(const QString& name) {
+  const QStringList names{"materials", "labels", "render"};
+  if (names.contains(name.toLower())) tabs_->setCurrentIndex(names.indexOf(name.toLower()));
 }
 
 void MainWindow::dragEnterEvent(QDragEnterEvent* event) {

@@ -16,6 +16,7 @@ class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
 class QMenu;
+class QTabWidget;
 class QTimer;
 
 namespace mmrtm::viewer {
@@ -51,6 +52,9 @@ class MainWindow : public QMainWindow {
     chooseSeries_ = std::move(chooser);
   }
 
+  // Brings an editor to the front: "materials", "labels" or "render".
+  void showEditor(const QString& name);
+
   ViewerScene& scene() { return *scene_; }
   VtkOpenGLWidget* view() { return view_; }
   TransferFunctionEditor* transferFunctionEditor() { return editor_; }
@@ -81,6 +85,7 @@ class MainWindow : public QMainWindow {
   LabelTableWidget* labels_ = nullptr;
   RenderSettingsWidget* settings_ = nullptr;
   QLabel* status_ = nullptr;
+  QTabWidget* tabs_ = nullptr;
   QMenu* presets_ = nullptr;
   QTimer* refine_ = nullptr;
   QElapsedTimer sinceRestart_;

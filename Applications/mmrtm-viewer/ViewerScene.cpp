@@ -16,6 +16,7 @@
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
 
+#include "label_materials.h"
 #include "label_table.h"
 #include "mmrtmVolumeLoader.h"
 #include "scene_json.h"
@@ -175,7 +176,42 @@ void ViewerScene::AdoptLabels(vtkImageData* labels, const std::string& path, con
   mapper_->SetMaskInput(labelMap_);
   mapper_->SetMaskTypeToLabelMap();
   if (!labelTablePath_.empty()) OpenLabelTable(labelTablePath_);  // names and colours for the new labels
+  RefreshLabelEntries();
   Apply();
+}
+
+// The labels' entries as the description draws them (the classes of its
+// label_materials, the table's names and colours), but for the labels the
+// user edited.
+void ViewerScene::RefreshLabelEntries() {
+  if (!labelMap_ || labels_.isEmpty()) return;
+  std::vector<int> ids;
+  for (const LabelEntry& l : labels_) ids.push_back(l.id);
+  LabelTable table;
+  if (!labelTablePath_.empty()) table = ReadLabelTable(labelTablePath_);
+  json doc = description_;
+  if (!doc.contains("label_materials")) doc["label_materials"] = DefaultLabelMaterials();
+  doc.erase("material_tfs");
+  const json expanded = ExpandLabelMaterials(doc, ids, labelTablePath_.empty() ? nullptr : &table);
+  if (!expanded.contains("material_tfs")) return;
+  for (const json& point : expanded["material_tfs"][0]["points"]) {
+    const int id = point[0].get<int>();
+    if (std::find(editedLabels_.begin(), editedLabels_.end(), id) != editedLabels_.end()) continue;
+    const std::string name = point[1].get<std::string>();
+    const json& m = expanded["materials"][name];
+    for (LabelEntry& l : labels_)
+      if (l.id == id) {
+        if (const mmrtm::LabelEntry* entry = labelTablePath_.empty() ? nullptr : table.Find(id))
+          l.name = QString::fromStdString(entry->name);
+        const json albedo = m.value("albedo", json({1.0, 1.0, 1.0}));
+        l.color = QColor::fromRgbF(std::clamp(albedo[0].get<double>(), 0.0, 1.0),
+                                   std::clamp(albedo[1].get<double>(), 0.0, 1.0),
+                                   std::clamp(albedo[2].get<double>(), 0.0, 1.0));
+        l.surfaceProbability = m.value("surface_probability", 0.0);
+        l.roughness = m.value("roughness", 0.5);
+        l.opacity = std::min(1.0, m.value("density", 1.0) / kLabelDensity);
+      }
+  }
 }
 
 void ViewerScene::OpenLabelTable(const std::string& path) {
@@ -191,6 +227,7 @@ void ViewerScene::OpenLabelTable(const std::string& path) {
       label.name = QString::fromStdString(entry->name);
       label.color = QColor::fromRgbF(entry->color[0], entry->color[1], entry->color[2]);
     }
+  RefreshLabelEntries();
   Apply();
 }
 
@@ -212,6 +249,7 @@ void ViewerScene::SetPreset(const std::string& name) {
   description_ = doc;
   preset_ = name;
   ResetFromDescription();
+  RefreshLabelEntries();
   Apply();
 }
 
@@ -282,6 +320,7 @@ void ViewerScene::LoadScene(const std::string& path) {
   description_.erase("label_table");
   preset_ = fs::path(path).stem().string();
   ResetFromDescription();
+  RefreshLabelEntries();
   const json render = doc.value("render", json::object());
   settings_.maximumSamples = render.value("spp", settings_.maximumSamples);
   mapper_->SetSeed(render.value("seed", 0));

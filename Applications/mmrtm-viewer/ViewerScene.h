@@ -99,6 +99,7 @@ class ViewerScene {
   static QVector<LabelEntry> LabelsPresent(vtkImageData* labels, vtkImageData* volume, const std::string& path);
   void AdoptLabels(vtkImageData* labels, const std::string& path, const QVector<LabelEntry>& present);
   void ResetFromDescription();
+  void RefreshLabelEntries();
   nlohmann::json& DensityTF(const std::string& material);
   nlohmann::json& AlbedoTF(const std::string& material);
 

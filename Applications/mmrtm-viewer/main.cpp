@@ -31,6 +31,8 @@ int main(int argc, char* argv[]) {
   parser.addOption({"preset", "material preset (Data/presets: ct-bone, ct-soft-tissue, ct-organs, mri, ...)", "NAME"});
   parser.addOption({"screenshot", "render until --samples samples per pixel, save the window as PNG, quit", "PNG"});
   parser.addOption({"samples", "samples per pixel for --screenshot (default 32)", "N", "32"});
+  parser.addOption({"window", "with --screenshot: the whole window, not only the view"});
+  parser.addOption({"tab", "with --screenshot: the editor tab to show (materials, labels, render)", "NAME"});
   parser.process(app);
 
   mmrtm::viewer::MainWindow window;
@@ -50,13 +52,15 @@ int main(int argc, char* argv[]) {
 
   if (parser.isSet("screenshot")) {
     if (!ok) return 1;
+    if (parser.isSet("tab")) window.showEditor(parser.value("tab"));
     const int samples = parser.value("samples").toInt();
     QObject::connect(window.view(), &mmrtm::viewer::VtkOpenGLWidget::rendered, &app, [&] {
       vtkMultiMaterialVolumeMapper* mapper = window.scene().Mapper();
       if (mapper->GetAccumulatedSamples() < samples && !mapper->IsConverged()) return;
       // After this paint has finished: grabbing renders the widget again.
       QTimer::singleShot(0, &app, [&] {
-        const bool saved = window.saveImage(parser.value("screenshot"));
+        const QString path = parser.value("screenshot");
+        const bool saved = parser.isSet("window") ? window.grab().save(path, "PNG") : window.saveImage(path);
         std::fprintf(stderr, "%s: %d samples per pixel\n", qPrintable(parser.value("screenshot")),
                      window.scene().Mapper()->GetAccumulatedSamples());
         app.exit(saved ? 0 : 1);

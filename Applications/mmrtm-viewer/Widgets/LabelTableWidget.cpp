@@ -24,7 +24,12 @@ LabelTableWidget::LabelTableWidget(QWidget* parent) : QTableWidget(parent) {
   setHorizontalHeaderLabels({tr("Label"), tr("Name"), tr("Colour"), tr("Visible"), tr("Opacity"), tr("Surface"),
                              tr("Roughness")});
   verticalHeader()->setVisible(false);
+  verticalHeader()->setDefaultSectionSize(24);
+  horizontalHeader()->setSectionResizeMode(QHeaderView::Fixed);
   horizontalHeader()->setSectionResizeMode(Name, QHeaderView::Stretch);
+  for (const auto& [column, width] : {std::pair{Id, 40}, {Color, 44}, {Visible, 48}, {Opacity, 58}, {Surface, 58},
+                                      {Roughness, 64}})
+    setColumnWidth(column, width);
   setSelectionBehavior(QAbstractItemView::SelectRows);
   setEditTriggers(QAbstractItemView::NoEditTriggers);
 }
@@ -50,9 +55,8 @@ void LabelTableWidget::fillRow(int row) {
   setItem(row, Id, new QTableWidgetItem(QString::number(e.id)));
   setItem(row, Name, new QTableWidgetItem(e.name));
   auto* swatch = new QPushButton;
-  swatch->setFlat(true);
-  swatch->setAutoFillBackground(true);
-  swatch->setStyleSheet(QString("background-color: %1").arg(e.color.name()));
+  swatch->setToolTip(tr("Colour of %1: click to change").arg(e.name));
+  swatch->setStyleSheet(QString("background-color: %1; border: 1px solid #404040; margin: 3px").arg(e.color.name()));
   connect(swatch, &QPushButton::clicked, this, [this, row] {
     const QColor chosen = QColorDialog::getColor(labels_[row].color, this, labels_[row].name);
     if (!chosen.isValid()) return;
