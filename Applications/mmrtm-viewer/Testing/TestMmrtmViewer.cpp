@@ -263,6 +263,23 @@ class TestMmrtmViewer : public QObject {
     QCOMPARE(differing, size_t(0));
   }
 
+  void closingTheWindowWhileItRefinesIsClean() {
+    auto* window = new MainWindow;
+    window->setErrorHandler([](const QString&) {});
+    window->resize(1000, 640);
+    window->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window));
+    mmrtm::viewer::RenderSettings s = window->renderSettings()->settings();
+    s.maximumSamples = 100000;  // it would refine for minutes
+    window->scene().SetSettings(s);
+    QVERIFY(window->openVolume(Data("ct_head_cranium.nrrd")));
+    QVERIFY(RefineTo(*window, 2));
+    QVERIFY(!window->scene().Mapper()->IsConverged());
+    window->close();
+    delete window;  // with refinement steps scheduled
+    QTest::qWait(300);  // the event loop runs on: nothing refers to the window
+  }
+
   void windowScreenshotMatchesTheBaseline() {
     Viewer v;
     QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
