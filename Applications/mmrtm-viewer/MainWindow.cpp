@@ -38,6 +38,10 @@
 #include "vtkMultiMaterialVolumeMapper.h"
 
 namespace mmrtm::viewer {
+namespace {
+// How often a pass running in the background is looked at.
+constexpr int kPollMilliseconds = 15;
+}  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), scene_(std::make_unique<ViewerScene>()) {
   setWindowTitle(tr("MM-RTM viewer"));
@@ -83,8 +87,14 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), scene_(std::make_
 
   refine_ = new QTimer(this);
   refine_->setSingleShot(true);
-  refine_->setInterval(0);
-  connect(refine_, &QTimer::timeout, view_, qOverload<>(&QWidget::update));
+  // A refinement step: a repaint, unless a pass still runs in the
+  // background (then only a look later: the event loop does no work).
+  connect(refine_, &QTimer::timeout, this, [this] {
+    if (scene_->Mapper()->IsRefining())
+      refine_->start(kPollMilliseconds);
+    else
+      view_->update();
+  });
   connect(view_, &VtkOpenGLWidget::rendered, this, &MainWindow::onRendered);
   connect(view_, &VtkOpenGLWidget::cameraChanged, this, [this] { sinceRestart_.restart(), samplesAtRestart_ = 0; });
   connect(editor_, &TransferFunctionEditor::edited, this, &MainWindow::applyEditor);
@@ -331,15 +341,19 @@ void MainWindow::applyEditor(bool interactive) {
 }
 
 void MainWindow::scheduleRender() {
-  if (scene_->HasVolume()) refine_->start();
+  if (scene_->HasVolume()) refine_->start(0);
 }
 
 void MainWindow::onRendered() {
   const bool failed = !renderError_.isEmpty();
   updateStatus();
   if (failed) return;  // no refinement of a scene the tracer refuses; the next edit tries again
-  // Keep refining while the image is not converged and nothing is dragged.
-  if (scene_->HasVolume() && !view_->Interacting() && !editing_ && !scene_->Mapper()->IsConverged()) refine_->start();
+  // Keep refining while the image is not converged and nothing is dragged:
+  // at once after a synchronous pass, a little later while a pass runs in
+  // the background (to draw its samples when it is done).
+  vtkMultiMaterialVolumeMapper* m = scene_->Mapper();
+  if (scene_->HasVolume() && !view_->Interacting() && !editing_ && !m->IsConverged())
+    refine_->start(m->IsRefining() ? kPollMilliseconds : 0);
 }
 
 void MainWindow::updateStatus() {

@@ -96,6 +96,8 @@ ViewerScene::ViewerScene() {
   vtkNew<vtkVolumeProperty> property;  // the description replaces its functions
   volume_->SetProperty(property);
   mapper_->SetMultiMaterialProperty(materials_);
+  // Refinement passes run beside the event loop (the window stays responsive).
+  mapper_->AsynchronousRefinementOn();
   mapper_->SetSamplesPerRender(settings_.samplesPerRender);
   SetSettings(settings_);
 }

@@ -515,6 +515,35 @@ class MapperTest(unittest.TestCase):
         self.assertGreater(other_seed, 0.0)
         self.assertLess(mean_abs_difference(octree, global_majorant), 1.5 * other_seed)
 
+    def test_asynchronous_refinement_gives_the_same_image(self):
+        import time
+        sync, asynchronous = Scene(), Scene()
+        asynchronous.mapper.AsynchronousRefinementOn()
+        for _ in range(4):
+            sync.render()
+        # The first render after the start is synchronous; the others start
+        # a pass in the background and return at once.
+        asynchronous.render()
+        self.assertEqual(asynchronous.mapper.GetAccumulatedSamples(), 2)
+        renders = 0
+        while asynchronous.mapper.GetAccumulatedSamples() < 8 and renders < 2000:
+            asynchronous.render()
+            renders += 1
+            time.sleep(0.005)
+        self.assertEqual(asynchronous.mapper.GetAccumulatedSamples(), 8)
+        self.assertFalse(asynchronous.mapper.IsRefining())
+        self.assertEqual(asynchronous.pixels(), sync.pixels(), "one seed, one image")
+        self.assertEqual(asynchronous.counts(), (1, 1, 1))
+        # A camera change while a pass is in flight stops it and restarts.
+        asynchronous.mapper.SetMaximumSamples(64)
+        asynchronous.render()
+        asynchronous.render()
+        self.assertTrue(asynchronous.mapper.IsRefining())
+        asynchronous.renderer.GetActiveCamera().Azimuth(30)
+        asynchronous.render()
+        self.assertEqual(asynchronous.counts()[2], 3)  # the settings change, then the camera
+        self.assertEqual(asynchronous.mapper.GetAccumulatedSamples(), 2)
+
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()
         a.render()

@@ -1,11 +1,13 @@
 #include "vtkMultiMaterialVolumeMapper.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <vtkCamera.h>
@@ -83,6 +85,24 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::vector<double> View;
   std::vector<float> Depth;  // the depth buffer under the volume at the last restart
   bool HasScene = false, Warned = false;
+
+  // Asynchronous refinement: the pass in flight adds samples to Film on a
+  // thread of its own while renders draw Shown (Film as of the last pass
+  // that finished). Stamp is what the pass was started under: a render
+  // that finds anything else stops the pass (between tiles) first.
+  struct Pass
+  {
+    std::thread Thread;
+    std::atomic<bool> Cancel{ false }, Done{ false }, Completed{ false };
+    std::string Error;
+  };
+  std::unique_ptr<Pass> InFlight;
+  std::unique_ptr<mmrtm::Film> Shown;
+  struct Stamp
+  {
+    std::vector<double> View;     // compared as views are (SameView)
+    std::vector<double> Exact;    // modification times, objects, depth, settings
+  } PassStamp;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0;
   double LastBuildSeconds = 0;
@@ -235,10 +255,42 @@ vtkMultiMaterialVolumeMapper::vtkMultiMaterialVolumeMapper()
 {
 }
 
-vtkMultiMaterialVolumeMapper::~vtkMultiMaterialVolumeMapper() = default;
+vtkMultiMaterialVolumeMapper::~vtkMultiMaterialVolumeMapper()
+{
+  this->FinishPass(true);
+}
+
+void vtkMultiMaterialVolumeMapper::FinishPass(bool cancel)
+{
+  Internals& in = *this->Internal;
+  if (!in.InFlight)
+    return;
+  if (cancel)
+    in.InFlight->Cancel = true;
+  in.InFlight->Thread.join();
+  if (!in.InFlight->Error.empty())
+    vtkErrorMacro("Render: " << in.InFlight->Error);
+  if (in.InFlight->Completed)
+    in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
+  else
+    in.Film.reset();  // a partial pass: the next render restarts
+  in.InFlight.reset();
+}
+
+const mmrtm::Film* vtkMultiMaterialVolumeMapper::ImageFilm()
+{
+  Internals& in = *this->Internal;
+  return in.InFlight ? in.Shown.get() : in.Film.get();
+}
+
+bool vtkMultiMaterialVolumeMapper::IsRefining()
+{
+  return this->Internal->InFlight && !this->Internal->InFlight->Done;
+}
 
 void vtkMultiMaterialVolumeMapper::ResetAccumulation()
 {
+  this->FinishPass(true);
   if (this->Internal->Film)
     this->Internal->Film->Reset();
 }
@@ -289,7 +341,8 @@ vtkImageData* vtkMultiMaterialVolumeMapper::GetMaskInput()
 
 int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
 {
-  return this->Internal->Film ? static_cast<int>(this->Internal->Film->Samples()) : 0;
+  const mmrtm::Film* film = this->ImageFilm();
+  return film ? static_cast<int>(film->Samples()) : 0;
 }
 
 void vtkMultiMaterialVolumeMapper::SetLabelMaterialParameters(int label, const char* json)
@@ -329,13 +382,13 @@ void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterialParameters()
 
 double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
 {
-  const mmrtm::Film* film = this->Internal->Film.get();
+  const mmrtm::Film* film = this->ImageFilm();
   return film && film->Samples() >= 2 ? film->Noise().relative : 0.0;
 }
 
 bool vtkMultiMaterialVolumeMapper::IsConverged()
 {
-  const mmrtm::Film* film = this->Internal->Film.get();
+  const mmrtm::Film* film = this->ImageFilm();
   if (!film)
     return false;
   const int accumulated = static_cast<int>(film->Samples());
@@ -350,7 +403,7 @@ void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
   if (!image)
     return;
   image->Initialize();
-  const mmrtm::Film* film = this->Internal->Film.get();
+  const mmrtm::Film* film = this->ImageFilm();
   if (!film || film->Samples() == 0)
     return;
   const int width = film->Width(), height = film->Height();
@@ -438,6 +491,44 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // Data: a new or modified input rebuilds the proxies and the grid's summaries.
     this->GetInputAlgorithm()->UpdateInformation();
     this->GetInputAlgorithm()->Update();
+
+    // Asynchronous refinement: a pass in flight goes on while nothing it
+    // depends on changed (the last finished image is drawn); else it is
+    // stopped, and this render goes on as usual.
+    vtkRenderWindow* window = ren->GetRenderWindow();
+    const bool interactive = this->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0;
+    auto stampNow = [&]() {
+      Internals::Stamp s;
+      s.View = ViewSignature(ren, vol, width, height);
+      for (const mmrtm::ClipPlane& p : this->ClipPlanes(vol))
+        s.View.insert(s.View.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
+      auto object = [](const void* p) { return static_cast<double>(reinterpret_cast<uintptr_t>(p)); };
+      vtkDataObject* data = this->GetInput();
+      s.Exact = { object(data), static_cast<double>(data ? data->GetMTime() : 0), object(in.Mask.Get()),
+        static_cast<double>(in.Mask ? in.Mask->GetMTime() : 0), object(property),
+        static_cast<double>(PropertyMTime(property)), object(in.MultiMaterial.Get()),
+        static_cast<double>(in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0),
+        static_cast<double>(in.LabelMaterialParametersTime.GetMTime()), static_cast<double>(this->GetMTime()),
+        static_cast<double>(in.EnvironmentTexture ? in.EnvironmentTexture->GetMTime() : 0) };
+      for (float d : ReadDepth(ren, width, height, originX, originY))
+        s.Exact.push_back(d);
+      return s;
+    };
+    if (in.InFlight)
+    {
+      if (!in.InFlight->Done && !interactive)
+      {
+        const Internals::Stamp now = stampNow();
+        if (now.Exact == in.PassStamp.Exact && SameView(now.View, in.PassStamp.View))
+        {
+          if (in.Shown)
+            this->Draw(ren, vol, *in.Shown);
+          return;
+        }
+      }
+      this->FinishPass(!in.InFlight->Done);
+    }
+
     input = vtkImageData::SafeDownCast(this->GetInput());
     if (!input)
       throw mmrtm::InputError("the input is not a vtkImageData");
@@ -585,8 +676,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       in.RendererThreads = this->NumberOfThreads;
       in.BackendDescription = in.Renderer->Description();
     }
-    vtkRenderWindow* window = ren->GetRenderWindow();
-    if (this->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0)
+    if (interactive)
     {
       this->RenderPreview(ren, width, height, 1.0 / window->GetDesiredUpdateRate());
       this->Draw(ren, vol, *in.Preview);
@@ -602,8 +692,34 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     const int samples = this->IsConverged() ? 0
       : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
                                             : this->SamplesPerRender;
+    if (samples > 0 && this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown)
+    {
+      // The next pass on a thread of its own; this render draws the last.
+      in.PassStamp = stampNow();
+      auto pass = std::make_unique<Internals::Pass>();
+      Internals::Pass* p = pass.get();
+      mmrtm::Renderer* renderer = in.Renderer.get();
+      mmrtm::Film* film = in.Film.get();
+      const mmrtm::Scene* scene = &in.Scene;
+      p->Thread = std::thread([p, renderer, film, scene, sceneView, samples] {
+        try
+        {
+          p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
+        }
+        catch (const std::exception& e)
+        {
+          p->Error = e.what();
+        }
+        p->Done = true;
+      });
+      in.InFlight = std::move(pass);
+      this->Draw(ren, vol, *in.Shown);
+      return;
+    }
     if (samples > 0)
       in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
+    if (this->AsynchronousRefinement)
+      in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
   }
   catch (const std::exception& e)
   {
@@ -928,5 +1044,5 @@ void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NoiseTarget: " << this->NoiseTarget << "\n";
   os << indent << "Accelerator: " << this->Accelerator << "\n";
   os << indent << "MaximumBounces: " << this->MaximumBounces << "\n";
-  os << indent << "AccumulatedSamples: " << (this->Internal->Film ? this->Internal->Film->Samples() : 0) << "\n";
+  os << indent << "AccumulatedSamples: " << this->GetAccumulatedSamples() << "\n";
 }

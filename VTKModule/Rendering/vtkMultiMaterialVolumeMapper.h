@@ -152,6 +152,24 @@ public:
 
   ///@{
   /**
+   * Refine on a thread of its own (default off). With it on, the first pass
+   * after a change renders in Render() as always, so the image shows the
+   * change at once; the passes after it run in the background while
+   * Render() draws the last finished pass and returns at once, so that an
+   * application's event loop stays responsive. A render that finds
+   * anything changed stops the pass in flight (between 16 x 16 tiles) and
+   * restarts. The images are the same as without it (one seed, one sample
+   * count). IsRefining() says whether a pass is in flight: an application
+   * renders again a little later to pick up its samples.
+   */
+  vtkSetMacro(AsynchronousRefinement, vtkTypeBool);
+  vtkGetMacro(AsynchronousRefinement, vtkTypeBool);
+  vtkBooleanMacro(AsynchronousRefinement, vtkTypeBool);
+  bool IsRefining();
+  ///@}
+
+  ///@{
+  /**
    * Exposure multiplier before tone mapping (default 1).
    */
   vtkSetClampMacro(Exposure, double, 0.0, VTK_DOUBLE_MAX);
@@ -320,6 +338,7 @@ protected:
   int Backend = AUTO;
   double Exposure = 1.0;
   double NoiseTarget = 0.0;
+  vtkTypeBool AsynchronousRefinement = 0;
   int Accelerator = OCTREE;
   int MaximumBounces = 32;
   double ShadowExtinctionScale = 0.8;
@@ -334,6 +353,8 @@ private:
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();
+  void FinishPass(bool cancel);
+  const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);

@@ -18,9 +18,9 @@ class CpuBackend : public Renderer {
   explicit CpuBackend(int threads) : cpu_(threads) {}
   std::string Description() const override { return "cpu, " + std::to_string(cpu_.Threads()) + " thread(s)"; }
   bool IsCuda() const override { return false; }
-  void Render(const Scene&, const SceneView& view, Film& film, int spp, TraceCounters* counters,
-              const Progress& progress) override {
-    cpu_.Render(view, film, spp, counters, progress);
+  bool Render(const Scene&, const SceneView& view, Film& film, int spp, TraceCounters* counters,
+              const Progress& progress, const std::atomic<bool>* cancel) override {
+    return cpu_.Render(view, film, spp, counters, progress, cancel);
   }
 
  private:
@@ -39,9 +39,9 @@ class CudaBackend : public Renderer {
     return "cuda, " + CudaDevice().name;
   }
   bool IsCuda() const override { return !fallback_; }
-  void Render(const Scene& scene, const SceneView& view, Film& film, int spp, TraceCounters* counters,
-              const Progress& progress) override {
-    if (fallback_) return fallback_->Render(scene, view, film, spp, counters, progress);
+  bool Render(const Scene& scene, const SceneView& view, Film& film, int spp, TraceCounters* counters,
+              const Progress& progress, const std::atomic<bool>* cancel) override {
+    if (fallback_) return fallback_->Render(scene, view, film, spp, counters, progress, cancel);
     try {
       // Every call uploads the view (the caller renders after a change);
       // the voxels only the first time.
@@ -52,11 +52,12 @@ class CudaBackend : public Renderer {
         gpu_.Refit(*grid, view.classifier, first_);
       first_ = false;
       gpu_.Render(film, spp, counters, progress);
+      return true;
     } catch (const DeviceMemoryError& e) {
       if (fallbackThreads_ < 0) throw;
       if (note_) note_(std::string(e.what()) + "; rendering on the CPU instead");
       fallback_ = std::make_unique<CpuBackend>(fallbackThreads_);
-      fallback_->Render(scene, view, film, spp, counters, progress);
+      return fallback_->Render(scene, view, film, spp, counters, progress, cancel);
     }
   }
 

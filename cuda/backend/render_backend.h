@@ -4,6 +4,7 @@
 // `cuda` without a device is a BackendError, not a crash. Host-only.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -41,10 +42,14 @@ class Renderer {
   virtual std::string Description() const = 0;
   virtual bool IsCuda() const = 0;
   // Adds `samplesPerPixel` samples of `view` (built by `scene`, whose grid
-  // the CUDA backend refits on the device) to `film`.
+  // the CUDA backend refits on the device) to `film`. Returns false when
+  // `cancel` (set from another thread) stopped the pass early: the film is
+  // then partial and must be reset (the CPU backend stops between tiles; a
+  // CUDA pass, short, runs to its end).
   using Progress = std::function<void(int, int)>;
-  virtual void Render(const Scene& scene, const SceneView& view, Film& film, int samplesPerPixel,
-                      TraceCounters* counters, const Progress& progress) = 0;
+  virtual bool Render(const Scene& scene, const SceneView& view, Film& film, int samplesPerPixel,
+                      TraceCounters* counters, const Progress& progress,
+                      const std::atomic<bool>* cancel = nullptr) = 0;
 };
 
 // `note` receives one-line remarks for the user (why auto chose the CPU, a

@@ -13,8 +13,8 @@ namespace mmrtm {
 CpuRenderer::CpuRenderer(int threads)
     : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())) {}
 
-void CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,
-                         const Progress& progress) const {
+bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,
+                         const Progress& progress, const std::atomic<bool>* cancel) const {
   const int width = film.Width(), height = film.Height();
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
   const int tileCount = tilesX * tilesY;
@@ -32,6 +32,7 @@ void CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel
   auto worker = [&](int thread) {
     TraceCounters& ctr = perThread[thread];
     for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
+      if (cancel && cancel->load(std::memory_order_relaxed)) break;
       const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
       const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
       for (int y = y0; y < y1; ++y)
@@ -53,9 +54,11 @@ void CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel
   worker(0);
   for (std::thread& t : pool) t.join();
 
+  if (cancel && cancel->load()) return false;
   film.AddSamples((uint32_t)samplesPerPixel);
   if (counters)
     for (const TraceCounters& c : perThread) *counters += c;
+  return true;
 }
 
 }  // namespace mmrtm

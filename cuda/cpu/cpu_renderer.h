@@ -4,6 +4,7 @@
 // same to the last bit at any thread count (DESIGN.md rule 2).
 #pragma once
 
+#include <atomic>
 #include <functional>
 
 #include "film.h"
@@ -23,8 +24,11 @@ class CpuRenderer {
 
   // Adds `samplesPerPixel` samples to every pixel of `film` (sample indices
   // continue from film.Samples()) and adds the work done to `counters`.
-  void Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters = nullptr,
-              const Progress& progress = nullptr) const;
+  // When `cancel` becomes true (from another thread) no further tile is
+  // started and false is returned: the film then holds a partial pass and
+  // must be reset before it is used again.
+  bool Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters = nullptr,
+              const Progress& progress = nullptr, const std::atomic<bool>* cancel = nullptr) const;
 
   static constexpr int kTileSize = 16;
 

@@ -71,9 +71,9 @@ int main(int argc, char** argv) {
   QTest::mouseRelease(editor, Qt::LeftButton, {}, from + QPoint(30, 0));
   QElapsedTimer sinceRelease;
   sinceRelease.start();
-  QTest::qWaitFor([&] { return mapper->GetAccumulatedSamples() >= 1; }, 60000);
+  if (!QTest::qWaitFor([&] { return mapper->GetAccumulatedSamples() >= 1; }, 60000)) return 1;
   const qint64 first = sinceRelease.elapsed();
-  QTest::qWaitFor([&] { return mapper->GetAccumulatedSamples() >= 16; }, 300000);
+  if (!QTest::qWaitFor([&] { return mapper->GetAccumulatedSamples() >= 16; }, 300000)) return 1;
   std::printf("after releasing a TF point: first full-resolution image %lld ms, 16 samples per pixel %lld ms; "
               "last refit %.1f ms\n", first, sinceRelease.elapsed(), mapper->GetLastRefitSeconds() * 1000);
   return 0;
