@@ -48,8 +48,10 @@ struct TransferFunctionView {
     if (IsDiscreteTF(type)) {
       float r = floorf(x + 0.5f);
       if (denseIndex) {
-        int i = (int)r - denseMin;
-        return (r >= (float)denseMin && i < denseCount) ? denseIndex[i] : -1;
+        // The range check in float first: a value far outside the keys (or
+        // NaN) must not be converted to int (undefined behaviour).
+        const float offset = r - (float)denseMin;
+        return (offset >= 0.f && offset < (float)denseCount) ? denseIndex[(int)offset] : -1;
       }
       int lo = 0, hi = count - 1;
       while (lo <= hi) {
