@@ -29,6 +29,7 @@
 #include <vtkImageData.h>
 #include <vtkPointData.h>
 #include <vtkRenderer.h>
+#include <vector>
 
 #include "LabelTableWidget.h"
 #include "RenderSettingsWidget.h"
@@ -259,7 +260,22 @@ bool MainWindow::loadScene(const QString& path) {
   if (!Attempt(showError_, [&] { scene_->LoadScene(path.toStdString()); })) return false;
   if (!view_->Renderer()->HasViewProp(scene_->Volume())) view_->Renderer()->AddVolume(scene_->Volume());
   showScene();
-  view_->ResetCamera();
+  const nlohmann::json& saved = scene_->SceneCamera();
+  if (saved.empty()) {
+    view_->ResetCamera();
+  } else {  // the scene's own view
+    vtkCamera* camera = view_->Renderer()->GetActiveCamera();
+    const auto v = [&](const char* key) { return saved[key].get<std::vector<double>>(); };
+    camera->SetPosition(v("position").data());
+    camera->SetFocalPoint(v("look_at").data());
+    if (saved.contains("up")) camera->SetViewUp(v("up").data());
+    if (saved.contains("fov")) camera->SetViewAngle(saved["fov"].get<double>());
+    const bool orthographic = saved.value("projection", "perspective") == "orthographic";
+    camera->SetParallelProjection(orthographic);
+    if (orthographic) camera->SetParallelScale(0.5 * saved.value("ortho_height", 2 * camera->GetParallelScale()));
+    view_->Renderer()->ResetCameraClippingRange();
+    view_->update();
+  }
   return true;
 }
 

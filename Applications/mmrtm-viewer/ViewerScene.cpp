@@ -311,16 +311,28 @@ void ViewerScene::LoadScene(const std::string& path) {
       throw std::runtime_error(e.what());
     }
   }
-  const std::string keepPreset = preset_;
-  preset_ = "scene";  // no preset is chosen by the volume's values
-  AdoptVolume(image, volume, "");
-  preset_ = keepPreset;
-  if (labelImage) AdoptLabels(labelImage, labels, present);
-  if (!table.empty()) OpenLabelTable(table);
+  const json camera = doc.value("camera", json::object());
+  const json savedCamera = camera.contains("position") && camera.contains("look_at") ? camera : json::object();
+  for (const char* key : {"position", "look_at", "up"}) {
+    if (!savedCamera.contains(key)) continue;
+    const json& v = savedCamera[key];
+    if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+      throw std::runtime_error(path + ": camera \"" + key + "\" must be three numbers");
+  }
+  for (const char* key : {"fov", "ortho_height"})
+    if (savedCamera.contains(key) && !savedCamera[key].is_number())
+      throw std::runtime_error(path + ": camera \"" + key + "\" must be a number");
+  if (savedCamera.contains("projection") && !savedCamera["projection"].is_string())
+    throw std::runtime_error(path + ": camera \"projection\" must be \"perspective\" or \"orthographic\"");
   description_ = doc;
   description_.erase("volumes");
   description_.erase("label_table");
-  preset_ = fs::path(path).stem().string();
+  preset_ = fs::path(path).stem().string();  // the scene's description, not a preset chosen by the values
+  sceneCamera_ = savedCamera;
+  labelTablePath_.clear();
+  AdoptVolume(image, volume, "");
+  if (labelImage) AdoptLabels(labelImage, labels, present);
+  if (!table.empty()) OpenLabelTable(table);
   ResetFromDescription();
   RefreshLabelEntries();
   const json render = doc.value("render", json::object());

@@ -61,6 +61,9 @@ class ViewerScene {
   // A scene saved by SaveScene (or any scene file with "volumes": scalars
   // and optionally labels): opens its volumes and takes its description.
   void LoadScene(const std::string& path);
+  // The explicit camera of the last scene loaded (position, look_at, up,
+  // fov), or an empty object when it has none.
+  const nlohmann::json& SceneCamera() const { return sceneCamera_; }
   void SaveScene(const std::string& path, vtkCamera* camera, int width, int height) const;
 
   // The materials of the description, and the density (0..1 curve) and
@@ -112,6 +115,7 @@ class ViewerScene {
   QVector<LabelEntry> labels_;
   std::vector<int> editedLabels_;  // labels with a class of their own in the description
   RenderSettings settings_;
+  nlohmann::json sceneCamera_ = nlohmann::json::object();
 };
 
 }  // namespace mmrtm::viewer

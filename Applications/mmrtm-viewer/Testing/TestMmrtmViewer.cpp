@@ -231,6 +231,18 @@ class TestMmrtmViewer : public QObject {
     QVERIFY(!v.window.openLabels(far));
     QVERIFY2(v.error.contains("does not overlap"), qPrintable(v.error));
     QVERIFY(!v.window.loadScene(folder.filePath("missing.json")));
+    // A hand-edited scene whose camera is not a point: named, nothing changed.
+    const QString badCamera = folder.filePath("bad_camera.json");
+    QFile sceneFile(badCamera);
+    QVERIFY(sceneFile.open(QIODevice::WriteOnly));
+    sceneFile.write(QString(R"({"volumes": {"scalars": {"file": "%1"}}, "camera": {"position": [1, 2], "look_at": [0, 0, 0]}})")
+                        .arg(Data("ct_head_headsq.nrrd"))
+                        .toUtf8());
+    sceneFile.close();
+    v.error.clear();
+    QVERIFY(!v.window.loadScene(badCamera));
+    QVERIFY2(v.error.contains("bad_camera.json") && v.error.contains("position"), qPrintable(v.error));
+    QVERIFY(v.window.scene().VolumePath().find("ct_head_cranium.nrrd") != std::string::npos);
     QVERIFY(RefineTo(v.window, 8));  // the head CT still renders
   }
 
@@ -238,6 +250,11 @@ class TestMmrtmViewer : public QObject {
     Viewer v;
     QVERIFY(v.window.openVolume(Data("ct_head_headsq.nrrd")));
     QVERIFY(v.window.setPreset("ct-bone"));
+    // A view of the user's own, not the one a reset gives: the scene keeps it.
+    v.window.view()->Renderer()->GetActiveCamera()->Azimuth(35);
+    v.window.view()->Renderer()->GetActiveCamera()->Elevation(-20);
+    v.window.view()->Renderer()->ResetCameraClippingRange();
+    v.window.view()->update();
     QVERIFY(RefineTo(v.window, 8));
     QTemporaryDir folder;
     const QString scene = folder.filePath("scene.json"), viewer = folder.filePath("viewer.pfm"),
@@ -261,6 +278,18 @@ class TestMmrtmViewer : public QObject {
     qInfo("viewer vs mmrtm-render: %zu of %zu values differ; %.0f lit pixels", differing, 3 * a.pixels.size(), lit);
     QVERIFY2(lit > 0.05 * a.pixels.size(), "an empty render");
     QCOMPARE(differing, size_t(0));
+    // The scene loaded into another window: the same view, the same image.
+    Viewer other;
+    QVERIFY2(other.window.loadScene(scene), qPrintable(other.error));
+    QVERIFY(RefineTo(other.window, 8));
+    const QString reloaded = folder.filePath("reloaded.pfm");
+    QVERIFY(other.window.saveLinearImage(reloaded));
+    const mmrtm::RGBImage c = mmrtm::ReadPFM(reloaded.toStdString());
+    QCOMPARE(c.pixels.size(), a.pixels.size());
+    size_t changed = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i)
+      for (int k = 0; k < 3; ++k) changed += a.pixels[i][k] != c.pixels[i][k];
+    QCOMPARE(changed, size_t(0));
   }
 
   void closingTheWindowWhileItRefinesIsClean() {
