@@ -90,6 +90,8 @@ std::vector<std::string> ListFiles(const std::string& folder) {
 int CheckDicomTransferSyntaxes(const std::string& folder, const std::vector<std::string>& files) {
   int part10 = 0;
   for (const std::string& file : files) {
+    const std::string problem = CheckDicomElementLengths(file);
+    if (!problem.empty()) throw InputError(folder + ": " + fs::path(file).filename().string() + ": " + problem);
     const std::string uid = ReadDicomTransferSyntax(file);
     if (uid.empty()) continue;
     ++part10;

@@ -77,6 +77,10 @@ std::vector<SliceHeader> ScanFolder(const std::string& folder) {
   const unsigned count = directory.Load(folder, false);
   if (count == 0) throw InputError(folder + ": the folder holds no files (expected the DICOM files of a series)");
 
+  for (const std::string& file : directory.GetFilenames()) {
+    const std::string problem = CheckDicomElementLengths(file);
+    if (!problem.empty()) throw InputError(folder + ": " + FileName(file) + ": " + problem);
+  }
   gdcm::Scanner scanner;
   for (const gdcm::Tag& t : {kSeriesUid, kSeriesDescription, kModality, kPosition, kOrientation, kPixelSpacing,
                              kRows, kColumns, kFrames, kSamplesPerPixel, kGantryTilt, kBitsAllocated, kTransferSyntax})

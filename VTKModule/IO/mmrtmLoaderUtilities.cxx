@@ -202,6 +202,19 @@ void CheckMemoryAvailable(const std::string& path, double bytes, const std::stri
                      HumanBytes(available) + " of memory available; nothing was allocated");
 }
 
+void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
+                             DataEncoding encoding) {
+  constexpr double kMaxDeflateRatio = 1032.0;  // zlib's limit for any input
+  const double needed = encoding == DataEncoding::Raw          ? declaredBytes
+                        : encoding == DataEncoding::Compressed ? declaredBytes / kMaxDeflateRatio
+                                                               : count;
+  if (!(needed <= fileBytes))
+    throw InputError(path + ": the header promises " + HumanBytes(declaredBytes) + " of voxels but the file holds " +
+                     HumanBytes(fileBytes) + (encoding == DataEncoding::Compressed ? " of compressed data" : "") +
+                     " (truncated, or a corrupt header); nothing was allocated");
+  CheckMemoryAvailable(path, 2.0 * declaredBytes, "the voxels");
+}
+
 void Warn(const VolumeLoadOptions& options, const std::string& message) {
   if (options.warn)
     options.warn(message);

@@ -88,27 +88,82 @@ uint64_t Inflate(const std::string& file, uint64_t offset, const std::string& wh
   return total;
 }
 
+std::string Field(const MetaImageHeader& h, const char* key) {
+  auto it = h.fields.find(key);
+  return it == h.fields.end() ? std::string() : it->second;
+}
+
+// Where the voxel data is: a file (the header itself for LOCAL) and the
+// offset of the data in it.
+struct MetaImageData {
+  std::string name;  // ElementDataFile as written
+  std::string file;
+  uint64_t offset = 0;
+  uint64_t fileSize = 0;
+  bool compressed = false;
+};
+
+// The data of a single data file; nullopt for data split over several files
+// (LIST, patterns) or at the end of a file of any size (HeaderSize -1), which
+// are left to the reader.
+std::optional<MetaImageData> LocateMetaImageData(const std::string& path, const MetaImageHeader& h) {
+  MetaImageData d;
+  d.name = Field(h, "ElementDataFile");
+  if (d.name.empty() || d.name == "LIST" || d.name.find('%') != std::string::npos) return std::nullopt;
+  const long headerSize = Field(h, "HeaderSize").empty() ? 0 : std::atol(Field(h, "HeaderSize").c_str());
+  if (headerSize < 0) return std::nullopt;  // -1: data at the end of the file, any size
+  const bool local = d.name == "LOCAL";
+  d.file = local ? path : (fs::path(path).parent_path() / d.name).string();
+  d.offset = (local ? h.size : 0) + (uint64_t)headerSize;
+  std::error_code ec;
+  d.fileSize = fs::file_size(d.file, ec);
+  if (ec) throw InputError(path + ": cannot open its data file " + d.name);
+  d.compressed = ToLower(Field(h, "CompressedData")) == "true";
+  return d;
+}
+
+// Bytes per value of a MetaImage ElementType; 0 if unknown (the reader then
+// names the problem).
+int MetaElementSize(const std::string& type) {
+  static const std::pair<const char*, int> kTypes[] = {
+      {"MET_CHAR", 1},  {"MET_UCHAR", 1}, {"MET_SHORT", 2},     {"MET_USHORT", 2},     {"MET_INT", 4},
+      {"MET_UINT", 4},  {"MET_LONG", 4},  {"MET_ULONG", 4},     {"MET_LONG_LONG", 8},  {"MET_ULONG_LONG", 8},
+      {"MET_FLOAT", 4}, {"MET_DOUBLE", 8}};
+  for (const auto& [name, size] : kTypes)
+    if (type == name) return size;
+  return 0;
+}
+
+// Before vtkMetaImageReader allocates: the voxels DimSize promises against
+// the data that holds them (CheckDeclaredVoxelBytes), and the data file is
+// there (metaio leaks its buffers when it is not: found by fuzzing).
+void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& h) {
+  const std::optional<MetaImageData> d = LocateMetaImageData(path, h);
+  const int size = MetaElementSize(Field(h, "ElementType"));
+  const std::vector<double> dims = ParseNumbers(Field(h, "DimSize"));
+  if (!d || size == 0 || dims.empty()) return;
+  double count = std::max(1.0, std::atof(Field(h, "ElementNumberOfChannels").c_str()));
+  for (double n : dims) {
+    if (!(n >= 1 && n <= 2147483647.0)) throw InputError(path + ": DimSize must be positive integers");
+    count *= n;
+  }
+  CheckDeclaredVoxelBytes(path, count * size, count, d->fileSize > d->offset ? double(d->fileSize - d->offset) : 0.0,
+                          d->compressed ? DataEncoding::Compressed : DataEncoding::Raw);
+}
+
 // metaio reports a short or damaged data file only on the console and
 // returns what it read, so check that all `bytes` of voxel data (the
-// reader's buffer `voxels`) are there. Data split over several files (LIST,
-// patterns) is left to the reader.
+// reader's buffer `voxels`) are there.
 void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint8_t* voxels, uint64_t bytes,
                         int valueSize, const VolumeLoadOptions& options) {
-  auto field = [&](const char* key) {
-    auto it = h.fields.find(key);
-    return it == h.fields.end() ? std::string() : it->second;
-  };
-  const std::string dataName = field("ElementDataFile");
-  if (dataName.empty() || dataName == "LIST" || dataName.find('%') != std::string::npos) return;
+  auto field = [&](const char* key) { return Field(h, key); };
+  const std::optional<MetaImageData> d = LocateMetaImageData(path, h);
+  if (!d) return;
+  const std::string& dataName = d->name;
+  const std::string& dataFile = d->file;
+  const uint64_t offset = d->offset, fileSize = d->fileSize;
+  const bool compressed = d->compressed;
   const long headerSize = field("HeaderSize").empty() ? 0 : std::atol(field("HeaderSize").c_str());
-  if (headerSize < 0) return;  // -1: data at the end of the file, any size
-  const bool local = dataName == "LOCAL";
-  const std::string dataFile = local ? path : (fs::path(path).parent_path() / dataName).string();
-  const uint64_t offset = (local ? h.size : 0) + (uint64_t)headerSize;
-  std::error_code ec;
-  const uint64_t fileSize = fs::file_size(dataFile, ec);
-  if (ec) throw InputError(path + ": cannot open its data file " + dataName);
-  const bool compressed = ToLower(field("CompressedData")) == "true";
   // A wrong CompressedDataSize (the Whole Frog header said 260020 for a
   // 262087-byte stream) makes metaio, in VTK as in ITK, stop early and leave
   // garbage in the last slices: inflate the whole stream here instead.
@@ -153,6 +208,7 @@ void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOpt
   const auto& fields = header.fields;
   if (fields.find("ObjectType") == fields.end() && fields.find("NDims") == fields.end())
     throw InputError(path + ": not a MetaImage header (no ObjectType or NDims)");
+  CheckMetaImageDeclaredSize(path, header);
   vtkNew<vtkMetaImageReader> reader;
   reader->SetFileName(path.c_str());
   vtkImageData* image = RunReader(reader, path);

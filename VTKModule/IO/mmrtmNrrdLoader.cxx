@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -38,7 +39,27 @@ struct NrrdHeader {
   std::vector<std::optional<Vec3d>> directions;  // per axis; nullopt = "none"
   std::optional<Vec3d> origin;
   std::vector<double> spacings;  // per axis, from the older `spacings` field
+  int typeSize = 0;              // bytes per value of `type`; 0 if unknown
+  std::string dataFile;          // `data file` as written; "" when the data is attached
+  int64_t headerBytes = 0;       // the header and its blank line
 };
+
+// Bytes per value of a NRRD `type` (teem's names and aliases); 0 if unknown
+// (vtkNrrdReader then names the problem).
+int NrrdTypeSize(const std::string& type) {
+  static const std::pair<const char*, int> kTypes[] = {
+      {"uchar", 1}, {"unsigned char", 1}, {"uint8", 1}, {"uint8_t", 1}, {"signed char", 1}, {"int8", 1},
+      {"int8_t", 1}, {"char", 1}, {"short", 2}, {"short int", 2}, {"signed short", 2}, {"signed short int", 2},
+      {"int16", 2}, {"int16_t", 2}, {"ushort", 2}, {"unsigned short", 2}, {"unsigned short int", 2},
+      {"uint16", 2}, {"uint16_t", 2}, {"int", 4}, {"signed int", 4}, {"int32", 4}, {"int32_t", 4}, {"uint", 4},
+      {"unsigned int", 4}, {"uint32", 4}, {"uint32_t", 4}, {"longlong", 8}, {"long long", 8},
+      {"long long int", 8}, {"signed long long", 8}, {"signed long long int", 8}, {"int64", 8}, {"int64_t", 8},
+      {"ulonglong", 8}, {"unsigned long long", 8}, {"unsigned long long int", 8}, {"uint64", 8},
+      {"uint64_t", 8}, {"float", 4}, {"double", 8}};
+  for (const auto& [name, size] : kTypes)
+    if (type == name) return size;
+  return 0;
+}
 
 // "(a,b,c)" -> vector; "none" -> nullopt. Throws on anything else.
 std::optional<Vec3d> ParseNrrdVector(const std::string& token, const std::string& path) {
@@ -73,27 +94,35 @@ std::vector<std::string> SplitNrrdVectors(const std::string& text) {
 }
 
 // Reads the header lines: up to the first blank line (a detached .nhdr header
-// is the whole file). Stops after 1 MiB so a file without a blank line is not
-// scanned as text to its end.
-std::vector<std::string> ReadNrrdHeaderLines(const std::string& path) {
+// is the whole file); `bytes` receives their length with the blank line.
+// Stops after 1 MiB so a file without a blank line is not scanned as text to
+// its end. A header is text: a control character (binary data where a field
+// should be) is an error here, before vtkNrrdReader sees it (a NUL in
+// `data file` made it grow a string array past a gigabyte).
+std::vector<std::string> ReadNrrdHeaderLines(const std::string& path, int64_t* bytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open");
   std::vector<std::string> lines;
   std::string line;
-  size_t bytes = 0;
-  while (std::getline(in, line) && bytes < (1u << 20)) {
-    bytes += line.size() + 1;
+  *bytes = 0;
+  while (*bytes < (1 << 20) && std::getline(in, line)) {
+    *bytes += (int64_t)line.size() + (in.eof() ? 0 : 1);
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) break;
+    if (lines.empty() && line.rfind("NRRD", 0) != 0) throw InputError(path + ": not a NRRD file (no NRRD magic)");
+    for (unsigned char c : line)
+      if (c < 0x20 && c != '\t')
+        throw InputError(path + ": line " + std::to_string(lines.size() + 1) +
+                         " of the NRRD header holds a control character (binary data in the header?)");
     lines.push_back(line);
   }
-  if (lines.empty() || lines[0].rfind("NRRD", 0) != 0) throw InputError(path + ": not a NRRD file (no NRRD magic)");
+  if (lines.empty()) throw InputError(path + ": not a NRRD file (no NRRD magic)");
   return lines;
 }
 
 NrrdHeader ParseNrrdHeader(const std::string& path) {
   NrrdHeader h;
-  const std::vector<std::string> lines = ReadNrrdHeaderLines(path);
+  const std::vector<std::string> lines = ReadNrrdHeaderLines(path, &h.headerBytes);
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::string& line = lines[i];
     if (line[0] == '#') continue;
@@ -112,6 +141,10 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
       h.space = ToLower(value);
     } else if (field == "encoding") {
       h.encoding = ToLower(value);
+    } else if (field == "type") {
+      h.typeSize = NrrdTypeSize(ToLower(value));
+    } else if (field == "data file" || field == "datafile") {
+      h.dataFile = value;
     } else if (field == "space directions") {
       h.hasSpaceDirections = true;
       for (const std::string& token : SplitNrrdVectors(value)) h.directions.push_back(ParseNrrdVector(token, path));
@@ -130,6 +163,31 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
     throw InputError(path + ": NRRD 'space directions' has " + std::to_string(h.directions.size()) +
                      " entries for " + std::to_string(h.dimension) + " axes");
   return h;
+}
+
+// The voxels the header promises against the bytes that hold them
+// (CheckDeclaredVoxelBytes), before vtkNrrdReader allocates for them. Data
+// split over several files (`data file: LIST` or a name pattern) is left to
+// the reader.
+void CheckNrrdDataSize(const NrrdHeader& h, const std::string& path) {
+  if (h.typeSize == 0) return;
+  if (!h.dataFile.empty() && (h.dataFile.find(' ') != std::string::npos || h.dataFile == "LIST")) return;
+  double count = 1;
+  for (int64_t n : h.sizes) count *= (double)n;
+  std::error_code ec;
+  double fileBytes;
+  if (h.dataFile.empty()) {
+    fileBytes = (double)std::filesystem::file_size(path, ec) - (double)h.headerBytes;
+  } else {
+    const std::filesystem::path data = std::filesystem::path(path).parent_path() / h.dataFile;
+    fileBytes = (double)std::filesystem::file_size(data, ec);
+    if (ec) throw InputError(path + ": its data file '" + h.dataFile + "' cannot be read (" + ec.message() + ")");
+  }
+  if (ec) throw InputError(path + ": cannot read its size (" + ec.message() + ")");
+  DataEncoding encoding = DataEncoding::Compressed;  // gzip, bzip2
+  if (h.encoding == "raw" || h.encoding == "hex") encoding = DataEncoding::Raw;  // hex: two characters a byte
+  if (h.encoding == "ascii" || h.encoding == "text" || h.encoding == "txt") encoding = DataEncoding::Text;
+  CheckDeclaredVoxelBytes(path, count * h.typeSize, count, std::max(0.0, fileBytes), encoding);
 }
 
 // Per-axis signs that take coordinates of a NRRD space to LPS. Spaces
@@ -193,6 +251,8 @@ void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions&
   if (spatial.empty() || spatial.size() > 3)
     throw InputError(path + ": a NRRD volume needs 1 to 3 spatial axes, this one has " +
                      std::to_string(spatial.size()));
+
+  CheckNrrdDataSize(h, path);
 
   vtkNew<vtkNrrdReader> reader;
   reader->SetFileName(path.c_str());

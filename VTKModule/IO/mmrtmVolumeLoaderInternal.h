@@ -43,6 +43,12 @@ double Dot(const Vec3d& a, const Vec3d& b);
 // explicit big endian): pixel data of a known size, which every reader decodes.
 bool IsUncompressedTransferSyntax(const std::string& uid);
 
+// Walks the data elements of a DICOM file and checks each stated length
+// against the bytes left in the file (mmrtmDicomElementCheck.cxx): "" when
+// they fit (or the file is not one the walk judges), else the problem, to
+// be reported before GDCM allocates a corrupt length.
+std::string CheckDicomElementLengths(const std::string& file);
+
 // ---------------------------------------------------------------------------
 // Voxel conversion (mmrtmLoaderUtilities.cxx)
 // ---------------------------------------------------------------------------
@@ -67,6 +73,19 @@ void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale resca
 // allocated, described by `what`) exceed the memory this machine has
 // available, before anything is allocated.
 void CheckMemoryAvailable(const std::string& path, double bytes, const std::string& what);
+
+// How voxel data is stored in a file, for CheckDeclaredVoxelBytes.
+enum class DataEncoding { Raw, Compressed, Text };
+
+// Checks a header's promise of `declaredBytes` of voxels (`count` values)
+// against the `fileBytes` that are to hold them, before any reader allocates
+// for it: raw data needs every byte; zlib/gzip data can shrink at most
+// 1032:1; text needs at least one character per value. Then
+// CheckMemoryAvailable. Throws InputError naming `path`: a truncated file or
+// a corrupt header ("sizes" that promise terabytes) is an error, not an
+// allocation attempt.
+void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
+                             DataEncoding encoding);
 
 // Sends a warning to options.warn, or to stderr.
 void Warn(const VolumeLoadOptions& options, const std::string& message);

@@ -577,7 +577,7 @@ json ReadJsonFile(const std::string& path) {
   if (!in) throw InputError(path + ": cannot open");
   try {
     return json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a syntax error, or a number out of range ("1e999")
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
 }
