@@ -285,6 +285,7 @@ int Run(const Options& o) {
   const auto tBuild = std::chrono::steady_clock::now();
   mmrtm::Scene scene = mmrtm::SceneFromJson(doc, std::move(inputs));
   mmrtm::SceneView view = scene.Build();
+  if (!scene.ExtinctionWarning().empty()) std::fprintf(stderr, "warning: %s\n", scene.ExtinctionWarning().c_str());
   const double buildSeconds = SecondsSince(tBuild);
 
   const mmrtm::RenderSettings& rs = scene.render;

@@ -73,7 +73,7 @@ std::string CheckDicomElementLengths(const std::string& file) {
     if (group != 0xFFFE && (explicitVr || inMeta) && IsVr(reinterpret_cast<const char*>(b + 4))) {
       std::memcpy(vr, b + 4, 2);
       if (HasLongLength(vr)) {
-        if (pos + 12 > size || !readAt(pos, 12)) break;
+        if (pos + 12 > size || !readAt(pos, 12)) break;  // reported below as cut off
         header = 12;
         length = U32(b + 8);
       } else {
@@ -87,6 +87,9 @@ std::string CheckDicomElementLengths(const std::string& file) {
       continue;
     }
     if (group == 0xFFFE && element == 0xE0DD) fragments = false;  // a sequence delimiter ends them
+    // GDCM asserts (aborts) on these in the meta group.
+    if (group == 0x0002 && (length == 0xFFFFFFFFu || (vr[0] == 'S' && vr[1] == 'Q')))
+      return where + " is a sequence or has an undefined length in the file meta information (corrupt)";
     if (length == 0xFFFFFFFFu) continue;  // undefined length: its items and delimiters follow
     if (length > size - pos)
       return where + " says its value is " + std::to_string(length) + " bytes, but only " +
@@ -104,6 +107,11 @@ std::string CheckDicomElementLengths(const std::string& file) {
     }
     pos += length;
   }
+  // A file cut off inside the meta group, or inside an element header: GDCM
+  // asserts on a few stray bytes right after the meta group. (A few bytes
+  // after the dataset are left alone: some writers pad files.)
+  if (pos < size && (inMeta || pos + 8 <= size))
+    return "the file ends inside a data element's header at byte " + std::to_string(pos) + " (truncated)";
   return "";
 }
 

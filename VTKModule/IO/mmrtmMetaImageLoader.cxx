@@ -138,7 +138,20 @@ int MetaElementSize(const std::string& type) {
 // the data that holds them (CheckDeclaredVoxelBytes), and the data file is
 // there (metaio leaks its buffers when it is not: found by fuzzing).
 void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& h) {
+  // metaio reads an empty ElementDataFile as a stream it then sizes as -1
+  // bytes (found by fuzzing).
+  if (Trim(Field(h, "ElementDataFile")).empty())
+    throw InputError(path + ": the MetaImage header names no ElementDataFile (LOCAL, or the data's file)");
   const std::optional<MetaImageData> d = LocateMetaImageData(path, h);
+  // metaio allocates CompressedDataSize bytes before reading them.
+  const std::string declared = Field(h, "CompressedDataSize");
+  if (d && d->compressed && !declared.empty()) {
+    const double stated = std::atof(declared.c_str()), available = d->fileSize > d->offset ? double(d->fileSize - d->offset) : 0.0;
+    if (!(stated >= 0) || stated > available)
+      throw InputError(path + ": CompressedDataSize says " + declared + " bytes but " +
+                       (d->name == "LOCAL" ? std::string("the file") : d->name) + " holds " +
+                       std::to_string((uint64_t)available) + " (truncated, or a corrupt header)");
+  }
   const int size = MetaElementSize(Field(h, "ElementType"));
   const std::vector<double> dims = ParseNumbers(Field(h, "DimSize"));
   if (!d || size == 0 || dims.empty()) return;

@@ -105,10 +105,17 @@ std::vector<std::string> ReadNrrdHeaderLines(const std::string& path, int64_t* b
   std::vector<std::string> lines;
   std::string line;
   *bytes = 0;
+  bool ended = false;  // by a blank line
   while (*bytes < (1 << 20) && std::getline(in, line)) {
-    *bytes += (int64_t)line.size() + (in.eof() ? 0 : 1);
+    // vtkNrrdReader reads a last line without a line end again and again
+    // (found by fuzzing): such a header is cut short, and an error here.
+    if (in.eof()) throw InputError(path + ": the NRRD header's last line has no line end (truncated?)");
+    *bytes += (int64_t)line.size() + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) break;
+    if (line.empty()) {
+      ended = true;
+      break;
+    }
     if (lines.empty() && line.rfind("NRRD", 0) != 0) throw InputError(path + ": not a NRRD file (no NRRD magic)");
     for (unsigned char c : line)
       if (c < 0x20 && c != '\t')
@@ -117,6 +124,11 @@ std::vector<std::string> ReadNrrdHeaderLines(const std::string& path, int64_t* b
     lines.push_back(line);
   }
   if (lines.empty()) throw InputError(path + ": not a NRRD file (no NRRD magic)");
+  const bool detached = std::any_of(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.rfind("data file:", 0) == 0 || l.rfind("datafile:", 0) == 0;
+  });
+  if (!ended && !detached)
+    throw InputError(path + ": no blank line ends the NRRD header, so there is no attached data (truncated?)");
   return lines;
 }
 

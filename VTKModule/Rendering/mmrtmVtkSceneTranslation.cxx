@@ -46,7 +46,8 @@ int AddCurve(Scene& scene, const std::string& where, int proxy, const std::vecto
 float Extinction(double alpha, double unit) { return (float)(-std::log(1.0 - std::clamp(alpha, 0.0, 0.9999)) / unit); }
 
 double UnitDistance(vtkVolumeProperty* property, int component) {
-  return std::max(property->GetScalarOpacityUnitDistance(component), 1e-6);
+  const double d = property->GetScalarOpacityUnitDistance(component);
+  return std::isnan(d) ? 1.0 : std::max(d, 1e-6);  // NaN: VTK's default; 0 or less: opaque (Classifier clamps)
 }
 
 // Shade, Specular and SpecularPower on a material (the rule in the header).
@@ -243,7 +244,9 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
 
 }  // namespace
 
-void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+namespace {
+
+void TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
   scene.tfs.clear();
   scene.materials.clear();
   scene.selectors.clear();
@@ -293,6 +296,27 @@ void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const 
   if (selector.keys.empty()) return;
   scene.tfs.push_back(std::move(selector));
   scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1);  // labels first
+}
+
+// NaN in (clamped or not) reaches the TF values and material bases; 0 in
+// their place (no extinction, black), counted.
+int ReplaceNonFinite(Scene& scene) {
+  int replaced = 0;
+  auto fix = [&](float& v) {
+    if (!std::isfinite(v)) v = 0.f, ++replaced;
+  };
+  for (TransferFunctionDesc& tf : scene.tfs)
+    for (float& v : tf.values) fix(v);
+  for (MaterialDesc& m : scene.materials)
+    for (float& v : m.base) fix(v);
+  return replaced;
+}
+
+}  // namespace
+
+int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+  TranslateMaterials(property, component, proxies, scene);
+  return ReplaceNonFinite(scene);
 }
 
 void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene) {

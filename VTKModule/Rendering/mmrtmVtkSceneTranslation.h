@@ -84,7 +84,10 @@ struct ProxyLayout {
 // default material), and with a label map one material per label that has
 // functions of its own, chosen by an MDPTF over the labels (a label's
 // material wins where its opacity is above zero, DESIGN.md's priority rule).
-void SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
+// Values that are not finite (a NaN opacity, colour, unit distance or
+// component weight in the property) are read as 0; returns how many there
+// were, for the caller to warn about.
+int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
 
 // Gives label `label`'s material (made by SetMaterialsFromProperty) the
 // surface and phase parameters VTK's label functions cannot say: a JSON

@@ -105,6 +105,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   } PassStamp;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0;
+  std::string LastExtinctionWarning;  // said once per change (vtkWarningMacro)
   double LastBuildSeconds = 0;
   // While the interactor moves the camera: a preview at 1/PreviewFactor of
   // the resolution, 1 sample per pixel, the factor adapted to the frame rate.
@@ -604,7 +605,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       (propertyTime != in.PropertyTime ||
         in.LabelMaterialParametersTime.GetMTime() != in.LabelMaterialParametersBuilt))
     {
-      mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene);
+      if (const int nonFinite = mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene))
+        vtkWarningMacro(<< "the volume property holds " << nonFinite
+                        << " value(s) that are not finite (NaN opacity, colour, unit distance or component "
+                           "weight); they were read as 0");
       if (in.Layout.labels >= 0)
       {
         for (const auto& [label, json] : in.LabelMaterialParameters)
@@ -686,6 +690,12 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     const auto buildStart = std::chrono::steady_clock::now();
     const mmrtm::SceneView sceneView = in.Scene.Build();
     in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
+    if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning)  // once per change, not per render
+    {
+      in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
+      if (!in.LastExtinctionWarning.empty())
+        vtkWarningMacro(<< in.LastExtinctionWarning);
+    }
     if (restart)  // the build after a change: a refit (or the summaries and a refit)
       in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
     const int accumulated = static_cast<int>(in.Film->Samples());

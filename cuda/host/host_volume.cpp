@@ -79,7 +79,15 @@ void HostVolume::Validate() const {
         throw InputError(msg.str());
       }
   }
-  View();  // throws on singular geometry
+  for (const auto& row : indexToWorld.m)
+    for (float v : row)
+      if (!std::isfinite(v))
+        throw InputError(where + ": its origin, spacing or direction is not finite (or out of float range)");
+  const VolumeView view = View();  // throws on singular geometry
+  for (const auto& row : view.worldToIndex.m)
+    for (float v : row)
+      if (!std::isfinite(v))
+        throw InputError(where + ": its spacing or direction is too close to singular to invert");
 }
 
 Affine3 IndexToWorld(const std::array<double, 3>& origin, const std::array<double, 3>& spacing,

@@ -2,6 +2,7 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -43,6 +44,28 @@ void WriteAtomically(const std::string& path, WriteFn write) {
   }
 }
 
+// The bytes from the stream's position to the end of the file.
+double BytesLeft(std::ifstream& in) {
+  const std::streampos here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streampos end = in.tellg();
+  in.seekg(here);
+  return here < 0 || end < here ? 0.0 : double(end - here);
+}
+
+// A header's image size against the bytes that can hold it (at least
+// `minBytes` of them), before the pixels are allocated: a corrupt header
+// ("-Y 1000000 +X 1000000") is an error, not a 12 TB allocation.
+void CheckImageSize(const std::string& path, int w, int h, double minBytes, double bytesLeft) {
+  if (w > 65536 || h > 65536)
+    throw InputError(path + ": " + std::to_string(w) + " x " + std::to_string(h) +
+                     " pixels is beyond the 65536 x 65536 this reader takes");
+  if (minBytes > bytesLeft)
+    throw InputError(path + ": the header promises " + std::to_string(w) + " x " + std::to_string(h) +
+                     " pixels but the file holds only " + std::to_string((long long)bytesLeft) +
+                     " bytes of pixel data (truncated, or a corrupt header)");
+}
+
 }  // namespace
 
 RGBImage ReadPFM(const std::string& path) {
@@ -56,6 +79,7 @@ RGBImage ReadPFM(const std::string& path) {
   if (!in || (magic != "PF" && magic != "Pf") || w <= 0 || h <= 0 || scale == 0)
     throw InputError(path + ": not a PFM file (bad header)");
   const int channels = magic == "PF" ? 3 : 1;
+  CheckImageSize(path, w, h, 4.0 * channels * w * h, BytesLeft(in));
   std::vector<float> raster((size_t)w * h * channels);
   in.read(reinterpret_cast<char*>(raster.data()), (std::streamsize)(raster.size() * sizeof(float)));
   if (!in) throw InputError(path + ": truncated PFM raster");
@@ -95,6 +119,10 @@ RGBImage ReadRGBE(const std::string& path) {
     if (ylabel != "-Y" || xlabel != "+X" || w <= 0 || h <= 0)
       throw InputError(path + ": unsupported resolution line '" + line + "' (need -Y H +X W)");
   }
+  // A row is 4 bytes a pixel, or (run-length encoded, 8 pixels wide or more)
+  // at least 4 bytes and 2 a run of up to 127 pixels per component.
+  const double rowBytes = w < 8 ? 4.0 * w : std::min(4.0 * w, 4.0 + 8.0 * std::ceil(w / 127.0));
+  CheckImageSize(path, w, h, h * rowBytes, BytesLeft(in));
   RGBImage image{w, h, std::vector<RGB>((size_t)w * h)};
   std::vector<uint8_t> scan((size_t)w * 4);
   auto byte = [&]() {
@@ -190,6 +218,16 @@ std::vector<uint8_t> ReadPNG(const std::string& path, int* width, int* height, i
     throw InputError(path + ": cannot read PNG (" + image.message + ")");
   const bool alpha = (image.format & PNG_FORMAT_FLAG_ALPHA) != 0;
   image.format = alpha ? PNG_FORMAT_RGBA : PNG_FORMAT_RGB;
+  // Before the pixels are allocated: at most 16384 pixels a side (the
+  // largest image mmrtm-render writes), and no more than deflate (1032:1)
+  // and 1-bit samples expanded to 8-bit RGBA (32:1) can make of the file.
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  const double fileBytes = file ? (double)file.tellg() : 0.0;
+  if (image.width > 16384 || image.height > 16384 || (double)PNG_IMAGE_SIZE(image) > 1032.0 * 32.0 * fileBytes) {
+    png_image_free(&image);
+    throw InputError(path + ": " + std::to_string(image.width) + " x " + std::to_string(image.height) +
+                     " pixels: more than this PNG reader takes (16384 a side) or the file can hold (corrupt header?)");
+  }
   std::vector<uint8_t> pixels(PNG_IMAGE_SIZE(image));
   if (!png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr))
     throw InputError(path + ": cannot read PNG (" + image.message + ")");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace mmrtm {
@@ -101,7 +102,18 @@ void Scene::Validate() const {
   if (r.integrator.maxBounces < 0) throw InputError("render: bounce limit must not be negative");
 }
 
-float Scene::GlobalMajorant() const {
+float Scene::MaxExtinction() const {
+  float finest = kInfinity;
+  for (int c = 0; c < 3; ++c) {
+    const Affine3& m = proxies[0].indexToWorld;
+    finest = std::min(finest, std::sqrt(m.m[0][c] * m.m[0][c] + m.m[1][c] * m.m[1][c] + m.m[2][c] * m.m[2][c]));
+  }
+  return finest > 0.f ? kMaxOpticalDepthPerVoxel / finest : kInfinity;
+}
+
+float Scene::GlobalMajorant() const { return std::min(UnclampedGlobalMajorant(), MaxExtinction()); }
+
+float Scene::UnclampedGlobalMajorant() const {
   // Each material's density is bounded by its base times the maximum of each
   // density TF over its proxy's whole value range; the classified density is
   // one of these, so their maximum bounds sigma_t everywhere.
@@ -272,7 +284,17 @@ SceneView Scene::Build() {
   // for. The grid's summaries depend only on the voxels; a TF change refits.
   const AcceleratorSettings& acc = render.accelerator;
   s.majorants.kind = acc.kind;
+  c.maxExtinction = MaxExtinction();
   s.majorants.globalMajorant = GlobalMajorant();
+  extinctionWarning_.clear();
+  if (const float reach = UnclampedGlobalMajorant(); !(reach <= c.maxExtinction)) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the materials' extinction reaches %.3g per mm; it is clamped to %.3g per mm (an optical depth of "
+                  "%.0f across the finest voxel spacing, %.3g mm), beyond which every voxel is opaque anyway",
+                  reach, c.maxExtinction, kMaxOpticalDepthPerVoxel, kMaxOpticalDepthPerVoxel / c.maxExtinction);
+    extinctionWarning_ = text;
+  }
   gridBuilt_ = false;
   if (acc.kind != MajorantKind::Global) {
     const MajorantGridOptions& o = acc.grid;

@@ -113,8 +113,14 @@ class Scene {
   SceneView Build();
 
   // sigma_t bound over the whole volume (the "none" accelerator's majorant),
-  // from the TFs as of the last Build.
+  // from the TFs as of the last Build, at most MaxExtinction().
   float GlobalMajorant() const;
+  // The clamp on sigma_t (Classifier::maxExtinction): an optical depth of
+  // kMaxOpticalDepthPerVoxel over the finest voxel spacing of proxy 0.
+  float MaxExtinction() const;
+  // After Build: a warning for the user when the materials reach past
+  // MaxExtinction() and were clamped to it ("" otherwise).
+  const std::string& ExtinctionWarning() const { return extinctionWarning_; }
 
   // After the voxels of a proxy change: the next Build rebuilds the grid's
   // summaries (a TF or material change only refits the majorants).
@@ -137,6 +143,7 @@ class Scene {
 
  private:
   void Validate() const;
+  float UnclampedGlobalMajorant() const;
   CameraView BuildCamera() const;
 
   std::vector<float> floatPool_;
@@ -150,6 +157,7 @@ class Scene {
   std::vector<const uint8_t*> summarisedVoxels_;    // per proxy, the buffers of the last data load
   bool dataModified_ = true;
   bool gridBuilt_ = false;
+  std::string extinctionWarning_;
   std::vector<std::array<std::array<int, 3>, 2>> modifiedRegions_;
 };
 

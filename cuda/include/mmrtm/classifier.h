@@ -17,6 +17,8 @@
 namespace mmrtm {
 
 constexpr int kMaxProxies = 4;
+// The largest optical depth one voxel may have (Classifier::maxExtinction).
+constexpr float kMaxOpticalDepthPerVoxel = 64.f;
 
 struct ProxySamples {
   float v[kMaxProxies] = {};
@@ -51,6 +53,14 @@ struct Classifier {
   // (one lookup, one TF), so that the multi-material machinery costs such a
   // scene nothing (DESIGN.md rule 3; Documentation/performance.md).
   bool plain = false;
+  // sigma_t is at most this (per mm): Scene::Build sets it to an optical
+  // depth of kMaxOpticalDepthPerVoxel over the tracked volume's finest
+  // spacing. Beyond it a voxel passes less than e^-64 of the light either
+  // way, but the null collisions a ray takes through a cell grow with the
+  // majorant: an extinction of 1e30/mm from a typed density, or VTK's
+  // opacity over a unit distance near 0, would never finish a ray. The
+  // majorants are clamped alike, so they stay bounds.
+  float maxExtinction = kInfinity;
 
   MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world) const {
     ProxySamples s;
@@ -84,7 +94,7 @@ struct Classifier {
       c.proxies.v[0] = proxies[0].SampleWorld(world);
       float v;
       tfs[bindings[materials[0].bindingBegin].tf].Evaluate(c.proxies.v[0], &v);
-      c.sigma_t = materials[0].base[0] * v;
+      c.sigma_t = Min(materials[0].base[0] * v, maxExtinction);
       c.material = 0;
       return c;
     }
@@ -92,6 +102,7 @@ struct Classifier {
     if (additive) {
       for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
       c.material = c.sigma_t > 0.f ? 0 : kNoMaterial;  // a mixture: see Coefficients
+      c.sigma_t = Min(c.sigma_t, maxExtinction);
       return c;
     }
     for (int i = 0; i < selectorCount; ++i) {
@@ -101,13 +112,13 @@ struct Classifier {
       float d = Density(m, c.proxies);
       if (d > 0.f) {
         c.material = m;
-        c.sigma_t = d;
+        c.sigma_t = Min(d, maxExtinction);
         return c;
       }
     }
     if (defaultMaterial != kNoMaterial) {
       c.material = defaultMaterial;
-      c.sigma_t = Density(defaultMaterial, c.proxies);
+      c.sigma_t = Min(Density(defaultMaterial, c.proxies), maxExtinction);
     }
     return c;
   }
@@ -133,14 +144,17 @@ struct Classifier {
     if (c.material == kNoMaterial) return out;
     float k[kCoefficientFloats];
     if (additive) {
-      // The mixture: each material's coefficients weighted by its share of sigma_t.
+      // The mixture: each material's coefficients weighted by its share of
+      // sigma_t (of the sum before the clamp: the shares add up to 1).
       for (int i = 0; i < kCoefficientFloats; ++i) k[i] = 0.f;
+      float total = 0.f;
+      for (int m = 0; m < materialCount; ++m) total += Density(m, c.proxies);
       for (int m = 0; m < materialCount; ++m) {
         const float d = Density(m, c.proxies);
         if (!(d > 0.f)) continue;
         float km[kCoefficientFloats];
         MaterialCoefficientArray(m, c.proxies, km);
-        const float w = d / c.sigma_t;
+        const float w = d / total;
         for (int i = 0; i < kCoefficientFloats; ++i) k[i] += w * km[i];
       }
     } else {

@@ -66,7 +66,7 @@ MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& 
     }
     majorant = c.additive ? majorant + d : Max(majorant, d);  // a mixture's extinctions add up
   }
-  return majorant;
+  return Min(majorant, c.maxExtinction);  // as Classify clamps sigma_t
 }
 
 // An upper-level node's bound: the maximum of its (up to 8) children.
