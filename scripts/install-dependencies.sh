@@ -12,6 +12,7 @@ packages=(
   qt6-base-dev libqt6opengl6-dev libqt6openglwidgets6 libxkbcommon-dev   # the Qt 6 viewer
   ninja-build              # the VTK 9.6 SDK and the wheel build (scripts/make-vtk-sdk.sh)
   python3-venv             # .venv: Mitsuba 3, numpy, matplotlib (accuracy checks and charts)
+  clang-14 libclang-rt-14-dev   # libFuzzer + sanitizer runtimes (Testing/Fuzz)
   invesalius-examples   # the default input: Cranium.inv3
 )
 as_root=()

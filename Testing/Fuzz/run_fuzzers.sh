@@ -11,6 +11,11 @@
 # BUILD/artifacts/<target>/. Keep it as Testing/Fuzz/regressions/<target>/<name>
 # (ctest then replays it in every build) and fix the code.
 #
+# Runs are deterministic: libFuzzer's seed is MMRTM_FUZZ_SEED (default 1; 0
+# picks one at random), so a run from an empty corpus is the start of the
+# same sequence of inputs on every machine, and a longer run here covers a
+# shorter one in CI.
+#
 # Usage: run_fuzzers.sh SOURCE_DIR BUILD_DIR SECONDS [TARGET...]
 # Writes BUILD/fuzz-summary.tsv: target, executions, corpus files, coverage
 # (edges), features, findings.
@@ -58,17 +63,22 @@ run_one() {
   # Inputs up to 64 KiB (a DICOM slice up to 1 MiB: its seeds are whole slices).
   local max_len=65536
   [ "$target" = dicom ] && max_len=1048576
-  local options=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024
+  local options=(-max_total_time="$seconds" -seed="${MMRTM_FUZZ_SEED:-1}" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024
                  -max_len=$max_len -print_final_stats=1 -artifact_prefix="$artifacts/")
   [ -f "$here/dictionaries/$target.dict" ] && options+=(-dict="$here/dictionaries/$target.dict")
   # Leaks count where the code is ours. VTK's readers and GDCM leak a few
   # hundred bytes on some error paths (reliability.md lists those found):
-  # not ours to fix, and they would stop every run of these targets.
+  # not ours to fix, and they would stop every run of these targets. Both
+  # switches are needed: libFuzzer's flag stops the check after each input,
+  # ASAN_OPTIONS the one at exit (which reports the run's total otherwise).
+  local asan_options="$ASAN_OPTIONS"
   case "$target" in
-    nrrd|nifti|metaimage|vtk-image|dicom) options+=(-detect_leaks=0) ;;
+    nrrd|nifti|metaimage|vtk-image|dicom)
+      options+=(-detect_leaks=0)
+      asan_options="${asan_options/detect_leaks=1/detect_leaks=0}" ;;
   esac
   # Runs from an empty folder: a target may write files relative to it.
-  (cd "$artifacts" && "$build/bin/fuzz-$target" "${options[@]}" "$corpus" "${inputs[@]}") \
+  (cd "$artifacts" && ASAN_OPTIONS="$asan_options" "$build/bin/fuzz-$target" "${options[@]}" "$corpus" "${inputs[@]}") \
     > "$build/logs/$target.log" 2>&1 || true
 }
 export -f run_one

@@ -9,7 +9,7 @@ transfer functions, the camera matrices) could still differ between
 versions; then some pixels' paths would diverge and this test reports how
 many, and by how much, instead of hiding it under a tolerance.
 
-Run by ctest under xvfb-run. Environment: MMRTM_VTK91_PYTHON and
+Run by ctest under Testing/headless.sh (its own Xvfb). Environment: MMRTM_VTK91_PYTHON and
 MMRTM_VTK91_PYTHONPATH (Debian's interpreter and the build tree's package),
 MMRTM_VTK96_PYTHON (the venv's interpreter, with the wheel installed).
 """

@@ -3,7 +3,7 @@ would: build a pipeline and render; change nothing and the samples
 accumulate; change a transfer function, the camera or the data and the
 mapper redoes exactly the work that change needs (counted by the mapper).
 
-Run by ctest under xvfb-run with /usr/bin/python3 (python3-vtk9) and the
+Run by ctest under Testing/headless.sh (its own Xvfb) with /usr/bin/python3 (python3-vtk9) and the
 build tree's mmrtm package on PYTHONPATH.
 """
 import os

@@ -3,7 +3,7 @@ pip brings with it) and the wheel: the package imports, reads volumes of
 each format the wheel reads (NRRD, NIfTI, MetaImage, VTK XML and legacy),
 finds its presets, and renders off screen.
 
-Run by ctest under xvfb-run after the test vtk96-wheel has built the wheel.
+Run by ctest under Testing/headless.sh (its own Xvfb) after the test vtk96-wheel has built the wheel.
 Environment: MMRTM_WHEEL_DIR (the folder with mmrtm-*.whl),
 MMRTM_SHARED_DATA_DIR. pip needs the package index or its cache for vtk.
 """

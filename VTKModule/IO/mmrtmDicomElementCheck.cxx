@@ -1,19 +1,31 @@
 // A walk over a DICOM file's data elements that checks each stated length
 // against the bytes left in the file, before GDCM reads it. GDCM allocates
-// an element's value at the length the file states: one corrupt length made
-// it ask for 2.2 GB for a 0.5 MB slice (found by fuzzing). The walk reads
-// only tags and lengths (values are skipped with seeks), so it costs little
-// next to GDCM's own read.
+// an element's value at the length the file states (one corrupt length made
+// it ask for 2.2 GB for a 0.5 MB slice), and Debian builds it with its
+// assertions on, which abort the program on a file cut off in an element
+// header (all found by fuzzing). The walk reads only tags and lengths
+// (values are skipped with seeks), so it costs little next to GDCM's read.
 #include "mmrtmVolumeLoaderInternal.h"
 
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <string>
 
 namespace mmrtm {
 namespace {
+
+// The value representations of DICOM PS3.5 (what GDCM's VR::IsValid takes).
+bool IsVr(const unsigned char* p) {
+  static const char* kVrs[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB",
+                               "OD", "OF", "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM",
+                               "UC", "UI", "UL", "UN", "UR", "US", "UT", "UV"};
+  for (const char* v : kVrs)
+    if (p[0] == (unsigned char)v[0] && p[1] == (unsigned char)v[1]) return true;
+  return false;
+}
 
 // VRs whose explicit-VR length is 4 bytes after 2 reserved ones.
 bool HasLongLength(const char vr[2]) {
@@ -23,15 +35,34 @@ bool HasLongLength(const char vr[2]) {
   return false;
 }
 
-bool IsVr(const char vr[2]) { return vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z'; }
-
-uint16_t U16(const unsigned char* p) { return uint16_t(p[0] | p[1] << 8); }
-uint32_t U32(const unsigned char* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+uint16_t U16(const unsigned char* p, bool big) { return big ? uint16_t(p[0] << 8 | p[1]) : uint16_t(p[0] | p[1] << 8); }
+uint32_t U32(const unsigned char* p, bool big) {
+  return big ? uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3])
+             : uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 
 std::string Hex4(unsigned v) {
   char text[8];
   std::snprintf(text, sizeof text, "%04X", v & 0xFFFF);
   return text;
+}
+
+// How the dataset is encoded.
+struct Syntax {
+  bool explicitVr = true;
+  bool bigEndian = false;
+};
+
+// A file without the "DICM" preamble: the encoding guessed from its first
+// element, as GDCM's FileMetaInformation::ReadCompat does; nullopt where
+// GDCM gives up on the file as not DICOM (a text file in the folder).
+std::optional<Syntax> GuessSyntax(const unsigned char* first) {
+  const unsigned group = U16(first, false), element = U16(first + 2, false);
+  const bool vr = IsVr(first + 4);
+  if (group == 0x0002 || group == 0x0008 || element == 0x0010) return Syntax{vr, false};
+  if (group == 0x0800) return Syntax{vr, true};  // group 8, big endian (ACR-NEMA)
+  if (vr) return Syntax{true, group > 0xFF || element > 0xFF};
+  return std::nullopt;
 }
 
 }  // namespace
@@ -47,49 +78,58 @@ std::string CheckDicomElementLengths(const std::string& file) {
     return (bool)in.read(reinterpret_cast<char*>(b), (std::streamsize)n);
   };
   uint64_t pos = 0;
-  if (size >= 132 && readAt(128, 4) && std::memcmp(b, "DICM", 4) == 0) pos = 132;
-  // Without the preamble, judge only what starts like a dataset (group 2 or
-  // 8, little endian); anything else is left to GDCM, which rejects it.
-  if (pos == 0 && !(readAt(0, 2) && (U16(b) == 0x0002 || U16(b) == 0x0008))) return "";
-
-  bool explicitVr = true;  // the meta group always is; the dataset as its transfer syntax says
-  bool inMeta = true;
+  const bool part10 = size >= 132 && readAt(128, 4) && std::memcmp(b, "DICM", 4) == 0;
+  bool inMeta = part10;    // the meta group, always explicit little endian
+  Syntax syntax;           // of the dataset
+  if (part10) {
+    pos = 132;
+  } else if (size < 6 || !readAt(0, 6)) {
+    return "";  // too short for a tag and a VR: GDCM rejects it without a fuss
+  } else {
+    const std::optional<Syntax> guess = GuessSyntax(b);
+    if (!guess) return "";  // not DICOM: GDCM skips it
+    syntax = *guess;
+    inMeta = U16(b, false) == 0x0002;
+  }
   bool fragments = false;  // inside encapsulated pixel data
   std::string transferSyntax;
   while (pos + 8 <= size) {
     if (!readAt(pos, 8)) return "";
-    const unsigned group = U16(b), element = U16(b + 2);
-    if (inMeta && group != 0x0002) {
+    if (inMeta && U16(b, false) != 0x0002) {
       inMeta = false;
-      // Big endian and deflated datasets are left to GDCM (rare; the walk
-      // would need their own decoding).
-      if (transferSyntax == "1.2.840.10008.1.2.2" || transferSyntax == "1.2.840.10008.1.2.1.99") return "";
-      explicitVr = transferSyntax != "1.2.840.10008.1.2";
-      if (transferSyntax.empty()) explicitVr = IsVr(reinterpret_cast<const char*>(b + 4));  // no meta group: guess
+      if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: left to GDCM
+      if (!transferSyntax.empty()) {
+        syntax.explicitVr = transferSyntax != "1.2.840.10008.1.2";
+        syntax.bigEndian = transferSyntax == "1.2.840.10008.1.2.2";
+      } else {
+        syntax.explicitVr = IsVr(b + 4);  // a meta group without a transfer syntax: guess
+      }
     }
+    const bool big = !inMeta && syntax.bigEndian;
+    const unsigned group = U16(b, big), element = U16(b + 2, big);
     uint64_t header = 8;
-    uint64_t length = U32(b + 4);
+    uint64_t length = U32(b + 4, big);
     char vr[2] = {0, 0};
-    if (group != 0xFFFE && (explicitVr || inMeta) && IsVr(reinterpret_cast<const char*>(b + 4))) {
+    if (group != 0xFFFE && (inMeta || syntax.explicitVr) && IsVr(b + 4)) {
       std::memcpy(vr, b + 4, 2);
       if (HasLongLength(vr)) {
         if (pos + 12 > size || !readAt(pos, 12)) break;  // reported below as cut off
         header = 12;
-        length = U32(b + 8);
+        length = U32(b + 8, big);
       } else {
-        length = U16(b + 6);
+        length = U16(b + 6, big);
       }
     }
     const std::string where = "element (" + Hex4(group) + "," + Hex4(element) + ") at byte " + std::to_string(pos);
     pos += header;
+    // GDCM asserts (aborts) on these in the meta group.
+    if (group == 0x0002 && (length == 0xFFFFFFFFu || (vr[0] == 'S' && vr[1] == 'Q')))
+      return where + " is a sequence or has an undefined length in the file meta information (corrupt)";
     if (group == 0x7FE0 && element == 0x0010 && length == 0xFFFFFFFFu) {
       fragments = true;  // encapsulated (compressed) pixel data: items of raw bytes follow
       continue;
     }
     if (group == 0xFFFE && element == 0xE0DD) fragments = false;  // a sequence delimiter ends them
-    // GDCM asserts (aborts) on these in the meta group.
-    if (group == 0x0002 && (length == 0xFFFFFFFFu || (vr[0] == 'S' && vr[1] == 'Q')))
-      return where + " is a sequence or has an undefined length in the file meta information (corrupt)";
     if (length == 0xFFFFFFFFu) continue;  // undefined length: its items and delimiters follow
     if (length > size - pos)
       return where + " says its value is " + std::to_string(length) + " bytes, but only " +
@@ -97,7 +137,8 @@ std::string CheckDicomElementLengths(const std::string& file) {
     // Items of a sequence and sequences: their elements follow and are
     // checked in turn. A fragment of pixel data is bytes: skipped.
     if ((group == 0xFFFE && !fragments) || (vr[0] == 'S' && vr[1] == 'Q')) continue;
-    if (!vr[0] && length >= 8 && readAt(pos, 4) && U16(b) == 0xFFFE && U16(b + 2) == 0xE000) continue;  // implicit SQ
+    if (!vr[0] && length >= 8 && readAt(pos, 4) && U16(b, big) == 0xFFFE && U16(b + 2, big) == 0xE000)
+      continue;  // a sequence in implicit VR: its first item follows
     if (group == 0x0002 && element == 0x0010 && length <= 64) {
       char uid[65] = {};
       in.clear();
@@ -107,10 +148,10 @@ std::string CheckDicomElementLengths(const std::string& file) {
     }
     pos += length;
   }
-  // A file cut off inside the meta group, or inside an element header: GDCM
-  // asserts on a few stray bytes right after the meta group. (A few bytes
-  // after the dataset are left alone: some writers pad files.)
-  if (pos < size && (inMeta || pos + 8 <= size))
+  // Cut off in an element header: GDCM asserts on a few stray bytes after
+  // the meta group or at the start of a file, or on a long VR's header cut
+  // short. (A few bytes after a dataset are left alone: some writers pad.)
+  if (pos < size && (inMeta || pos == 0 || pos + 8 <= size))
     return "the file ends inside a data element's header at byte " + std::to_string(pos) + " (truncated)";
   return "";
 }

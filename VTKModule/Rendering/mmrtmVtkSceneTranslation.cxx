@@ -12,9 +12,11 @@
 #include <vtkImageData.h>
 #include <vtkLight.h>
 #include <vtkLightCollection.h>
+#include <vtkNew.h>
 #include <vtkPiecewiseFunction.h>
 #include <vtkPointData.h>
 #include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
 #include <vtkVolumeProperty.h>
 
 namespace mmrtm {
@@ -78,6 +80,64 @@ bool UsesGradientOpacity(vtkVolumeProperty* property, int component) {
 
 namespace {
 
+// The property's functions with their non-finite node values read as 0 at
+// their node (a NaN x drops the node): VTK interpolates a NaN node value
+// into both neighbouring segments, which would empty them; 0 at the node
+// keeps the neighbours' ramps. Functions without such values are used as
+// they are; repaired copies live as long as this object.
+class FiniteFunctions {
+ public:
+  vtkPiecewiseFunction* Of(vtkPiecewiseFunction* f) {
+    if (!f || Finite(f, 4)) return f;
+    vtkNew<vtkPiecewiseFunction> copy;
+    copy->DeepCopy(f);
+    copy->RemoveAllPoints();
+    double node[4];
+    for (int i = 0; i < f->GetSize(); ++i) {
+      f->GetNodeValue(i, node);
+      if (Repair(node, 4)) copy->AddPoint(node[0], node[1], node[2], node[3]);
+    }
+    keep_.emplace_back(copy.Get());
+    return copy;
+  }
+  vtkColorTransferFunction* Of(vtkColorTransferFunction* f) {
+    if (!f || Finite(f, 6)) return f;
+    vtkNew<vtkColorTransferFunction> copy;
+    copy->DeepCopy(f);
+    copy->RemoveAllPoints();
+    double node[6];
+    for (int i = 0; i < f->GetSize(); ++i) {
+      f->GetNodeValue(i, node);
+      if (Repair(node, 6)) copy->AddRGBPoint(node[0], node[1], node[2], node[3], node[4], node[5]);
+    }
+    keep_.emplace_back(copy.Get());
+    return copy;
+  }
+  int replaced = 0;  // node values read as 0, nodes dropped
+
+ private:
+  template <class F>
+  static bool Finite(F* f, int count) {
+    double node[6];
+    for (int i = 0; i < f->GetSize(); ++i) {
+      f->GetNodeValue(i, node);
+      for (int k = 0; k < count; ++k)
+        if (!std::isfinite(node[k])) return false;
+    }
+    return true;
+  }
+  // Values to 0, midpoint and sharpness (the last two) to VTK's defaults;
+  // false: drop the node (its position is not finite).
+  bool Repair(double* node, int count) {
+    if (!std::isfinite(node[0])) return ++replaced, false;
+    const double defaults[2] = {0.5, 0.0};
+    for (int k = 1; k < count; ++k)
+      if (!std::isfinite(node[k])) node[k] = k >= count - 2 ? defaults[k - (count - 2)] : 0.0, ++replaced;
+    return true;
+  }
+  std::vector<vtkSmartPointer<vtkObject>> keep_;
+};
+
 // The functions of one material: the property's component functions, or a
 // label's (null members fall back to the component's).
 struct MaterialFunctions {
@@ -88,14 +148,14 @@ struct MaterialFunctions {
 };
 
 // Component c's own functions (its gradient opacity when it is used).
-MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c) {
+MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c, FiniteFunctions& finite) {
   MaterialFunctions f;
-  f.opacity = property->GetScalarOpacity(c);
+  f.opacity = finite.Of(property->GetScalarOpacity(c));
   if (property->GetColorChannels(c) == 3)
-    f.color = property->GetRGBTransferFunction(c);
+    f.color = finite.Of(property->GetRGBTransferFunction(c));
   else
-    f.grey = property->GetGrayTransferFunction(c);
-  if (UsesGradientOpacity(property, c)) f.gradientOpacity = property->GetGradientOpacity(c);
+    f.grey = finite.Of(property->GetGrayTransferFunction(c));
+  if (UsesGradientOpacity(property, c)) f.gradientOpacity = finite.Of(property->GetGradientOpacity(c));
   return f;
 }
 
@@ -246,7 +306,9 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
 
 namespace {
 
-void TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+// Returns how many function node values were not finite.
+int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+  FiniteFunctions finite;
   scene.tfs.clear();
   scene.materials.clear();
   scene.selectors.clear();
@@ -254,7 +316,7 @@ void TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyL
   if (proxies.independent > 1) {
     // A material per component, mixed additively; each reads its own proxy.
     for (int c = 0; c < proxies.independent; ++c) {
-      MaterialFunctions f = ComponentFunctions(property, c);
+      MaterialFunctions f = ComponentFunctions(property, c, finite);
       ProxyLayout own = proxies;  // this component's gradient proxy, if there was room for one
       own.gradient = proxies.componentGradient[c];
       own.gradientRange = proxies.componentGradientRanges[c];
@@ -265,9 +327,9 @@ void TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyL
     }
     scene.additiveMaterials = true;
     scene.defaultMaterial = kNoMaterial;
-    return;
+    return finite.replaced;
   }
-  const MaterialFunctions main = ComponentFunctions(property, component);
+  const MaterialFunctions main = ComponentFunctions(property, component, finite);
   if (vtkImageData* table = TransferFunction2D(property, component); table && proxies.gradient >= 0) {
     Add2DMaterials(table, property, component, proxies, scene);  // no default: outside the bands is empty
     scene.defaultMaterial = kNoMaterial;
@@ -277,7 +339,7 @@ void TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyL
   }
 
   // Labels: a material each, picked by an MDPTF over the label map.
-  if (proxies.labels < 0) return;
+  if (proxies.labels < 0) return finite.replaced;
   TransferFunctionDesc selector;
   selector.where = "label map";
   selector.type = TFType::MDPTF;
@@ -286,16 +348,18 @@ void TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyL
   for (int label : property->GetLabelMapLabels()) {
     if (label == 0) continue;  // 0 is unlabelled: the component's functions
     MaterialFunctions f = main;
-    if (vtkPiecewiseFunction* o = property->GetLabelScalarOpacity(label)) f.opacity = o;
-    if (vtkColorTransferFunction* c = property->GetLabelColor(label)) f.color = c, f.grey = nullptr;
-    if (vtkPiecewiseFunction* g = property->GetLabelGradientOpacity(label)) f.gradientOpacity = IsConstantOne(g) ? nullptr : g;
+    if (vtkPiecewiseFunction* o = property->GetLabelScalarOpacity(label)) f.opacity = finite.Of(o);
+    if (vtkColorTransferFunction* c = property->GetLabelColor(label)) f.color = finite.Of(c), f.grey = nullptr;
+    if (vtkPiecewiseFunction* g = property->GetLabelGradientOpacity(label))
+      f.gradientOpacity = IsConstantOne(g) ? nullptr : finite.Of(g);
     selector.keys.push_back((float)label);
     selector.materials.push_back((int)scene.materials.size());
     scene.materials.push_back(MakeMaterial("label " + std::to_string(label), f, property, component, proxies, scene));
   }
-  if (selector.keys.empty()) return;
+  if (selector.keys.empty()) return finite.replaced;
   scene.tfs.push_back(std::move(selector));
   scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1);  // labels first
+  return finite.replaced;
 }
 
 // NaN in (clamped or not) reaches the TF values and material bases; 0 in
@@ -315,8 +379,8 @@ int ReplaceNonFinite(Scene& scene) {
 }  // namespace
 
 int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
-  TranslateMaterials(property, component, proxies, scene);
-  return ReplaceNonFinite(scene);
+  const int nodes = TranslateMaterials(property, component, proxies, scene);
+  return nodes + ReplaceNonFinite(scene);
 }
 
 void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene) {

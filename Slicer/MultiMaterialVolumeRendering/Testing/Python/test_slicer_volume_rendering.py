@@ -5,7 +5,7 @@ volumes logic, display nodes made by the Volume Rendering logic, rendered by
 the displayable managers of a 3D view (LayerDM's, and Slicer's own volume
 rendering manager, which must ignore our node).
 
-Run by ctest under xvfb-run with the .venv-vtk96 interpreter, after the
+Run by ctest under Testing/headless.sh (its own Xvfb) with the .venv-vtk96 interpreter, after the
 mmrtm wheel (with its Slicer classes) was built and installed there.
 """
 import os
