@@ -199,6 +199,17 @@ class RenderCli(unittest.TestCase):
         scene = self.write("scene.json", "{\"materials\": ")
         self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "scene.json", "not valid JSON")
 
+    def test_deeply_nested_json(self):
+        # 2 million levels (4 MB) overflowed the stack when the document
+        # was copied; 101 levels are already refused, with brackets in
+        # strings and comments not counted.
+        for depth in (101, 2000000):
+            scene = self.write("scene.json", '{"camera": ' + "[" * depth + "]" * depth + "}")
+            self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "scene.json",
+                                "nested %d levels deep" % (depth + 1))
+        scene = self.write("scene.json", '// [[[[ {{{{\n{"materials": {"m": {"albdeo": "[[[[ {{{{ /*"}}} /* ]]]] */')
+        self.expect_failure(self.run_render(HEADSQ, "--scene", scene), "unknown key 'albdeo'")
+
     def test_unknown_preset(self):
         self.expect_failure(self.run_render(HEADSQ, "--preset", "nope"), "no preset named 'nope'", "ct-bone")
 

@@ -211,3 +211,28 @@ class UserNumbersTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+    def test_huge_component_weight_is_clamped_with_a_warning(self):
+        # Two independent components, the first weighted 1e30: its
+        # extinction is clamped (an optical depth of 64 per voxel), said
+        # once; the image is finite and the ball opaque.
+        image = sphere_volume()
+        ball = image.GetPointData().GetScalars()
+        two = vtkFloatArray()
+        two.SetNumberOfComponents(2)
+        two.SetNumberOfTuples(ball.GetNumberOfTuples())
+        for i in range(ball.GetNumberOfTuples()):
+            two.SetTuple2(i, ball.GetValue(i), 0.0)
+        image.GetPointData().SetScalars(two)
+        p = Pipeline(image)
+        p.property.IndependentComponentsOn()
+        for c in range(2):
+            p.property.SetScalarOpacity(c, p.opacity)
+            p.property.SetColor(c, p.color)
+        p.property.SetComponentWeight(0, 1e30)
+        p.render()
+        self.assertEqual(p.errors.messages, [])
+        self.assertIn("clamped", p.warnings.text())
+        self.assertEqual(len(p.warnings.messages), 1, p.warnings.text())
+        self.assert_finite_image(p)
+        self.assertGreater(max(p.film()[3::4]), 0.99)

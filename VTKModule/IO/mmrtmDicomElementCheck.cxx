@@ -83,8 +83,15 @@ std::string CheckDicomElementLengths(const std::string& file) {
   Syntax syntax;           // of the dataset
   if (part10) {
     pos = 132;
-  } else if (size < 6 || !readAt(0, 6)) {
-    return "";  // too short for a tag and a VR: GDCM rejects it without a fuss
+  } else if (size < 6) {
+    // Too short for a tag and a VR. GDCM rejects it without a fuss, but for
+    // a tag it takes for DICOM's (GuessSyntax's first rule): then it
+    // asserts reading the rest of the element's header (a fuzz finding).
+    if (size >= 4 && readAt(0, 4) && (U16(b, false) == 0x0002 || U16(b, false) == 0x0008 || U16(b + 2, false) == 0x0010))
+      return "the file ends inside a data element's header at byte 0 (truncated)";
+    return "";
+  } else if (!readAt(0, 6)) {
+    return "";
   } else {
     const std::optional<Syntax> guess = GuessSyntax(b);
     if (!guess) return "";  // not DICOM: GDCM skips it

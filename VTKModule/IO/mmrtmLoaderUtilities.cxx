@@ -202,6 +202,24 @@ void CheckMemoryAvailable(const std::string& path, double bytes, const std::stri
                      HumanBytes(available) + " of memory available; nothing was allocated");
 }
 
+void CheckFileNamePattern(const std::string& path, const std::string& what, const std::string& pattern) {
+  int conversions = 0;
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') continue;
+    if (i + 1 < pattern.size() && pattern[i + 1] == '%') {  // a literal %
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    while (j < pattern.size() && (std::isdigit((unsigned char)pattern[j]) || pattern[j] == '-')) ++j;
+    if (j >= pattern.size() || (pattern[j] != 'd' && pattern[j] != 'i'))
+      throw InputError(path + ": " + what + ": a file-name pattern may hold only integer conversions such as %d or %03d");
+    ++conversions;
+    i = j;
+  }
+  if (conversions != 1) throw InputError(path + ": " + what + ": a file-name pattern needs exactly one %d");
+}
+
 void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
                              DataEncoding encoding) {
   constexpr double kMaxDeflateRatio = 1032.0;  // zlib's limit for any input

@@ -6,6 +6,8 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include <initializer_list>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -134,6 +137,40 @@ int MetaElementSize(const std::string& type) {
   return 0;
 }
 
+// `ElementDataFile = <pattern> [<min> [<max> [<step>]]]` names one file per
+// slice: metaio formats each name with the pattern as a printf format and
+// divides by the step, which it computes as (max - min) / slices when it is
+// not given. So the pattern must hold exactly one integer conversion (%d,
+// %03d, ...) and nothing else printf reads, and the step must not be 0 or
+// lead away from max (a fuzz finding: a garbled ElementDataFile line
+// divided by zero).
+void CheckMetaImageFilePattern(const std::string& path, const std::string& value, double slices) {
+  std::istringstream in(value);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  const std::string problem = path + ": ElementDataFile '" + value + "': ";
+  // Five words or more: a pattern with spaces, then min, max and step.
+  size_t patternWords = words.size() >= 5 ? words.size() - 3 : 1;
+  std::string pattern = words.empty() ? "" : words[0];
+  for (size_t i = 1; i < patternWords; ++i) pattern += " " + words[i];
+  CheckFileNamePattern(path, "ElementDataFile '" + value + "'", pattern);
+  std::vector<double> numbers;
+  for (size_t i = patternWords; i < words.size(); ++i) {
+    char* end = nullptr;
+    const double v = std::strtod(words[i].c_str(), &end);
+    if (*end != '\0' || !(std::fabs(v) < 2147483647.0))
+      throw InputError(problem + "<min> <max> <step> after the pattern must be integers");
+    numbers.push_back(std::trunc(v));
+  }
+  // metaio's defaults: min 1; max min + slices - 1; step (max - min) / slices.
+  const double min = numbers.size() >= 1 ? numbers[0] : 1;
+  const double max = numbers.size() >= 2 ? numbers[1] : min + slices - 1;
+  const double step = numbers.size() >= 3 ? numbers[2] : numbers.size() == 2 ? std::trunc((max - min) / slices) : 1;
+  if (step == 0 || (max - min) / step < 0)
+    throw InputError(problem + "the step (" + std::to_string((long long)step) + ") does not go from " +
+                     std::to_string((long long)min) + " to " + std::to_string((long long)max));
+}
+
 // Before vtkMetaImageReader allocates: the voxels DimSize promises against
 // the data that holds them (CheckDeclaredVoxelBytes), and the data file is
 // there (metaio leaks its buffers when it is not: found by fuzzing).
@@ -142,6 +179,12 @@ void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& 
   // bytes (found by fuzzing).
   if (Trim(Field(h, "ElementDataFile")).empty())
     throw InputError(path + ": the MetaImage header names no ElementDataFile (LOCAL, or the data's file)");
+  if (Field(h, "ElementDataFile").find('%') != std::string::npos) {
+    const std::vector<double> dims = ParseNumbers(Field(h, "DimSize"));
+    if (dims.empty() || !(dims.back() >= 1 && dims.back() <= 2147483647.0))
+      throw InputError(path + ": DimSize must be positive integers");
+    CheckMetaImageFilePattern(path, Field(h, "ElementDataFile"), dims.back());
+  }
   const std::optional<MetaImageData> d = LocateMetaImageData(path, h);
   // metaio allocates CompressedDataSize bytes before reading them.
   const std::string declared = Field(h, "CompressedDataSize");

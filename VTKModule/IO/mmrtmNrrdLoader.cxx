@@ -177,13 +177,46 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
   return h;
 }
 
+// `data file: <format> <min> <max> <step> [<subdim>]` names its files by a
+// counter: all four must be integers, the step not 0 and towards `max`, and
+// there can be no more files than samples. vtkNrrdReader takes any words
+// as numbers and, with a step of 0, adds names until memory runs out (a
+// fuzz finding: a garbled `data file` line).
+void CheckNrrdFilePattern(const NrrdHeader& h, const std::string& path) {
+  std::istringstream in(h.dataFile);
+  std::string format, words[4];
+  in >> format;
+  int count = 0;
+  while (count < 4 && in >> words[count]) ++count;
+  auto integer = [](const std::string& w, long long* v) {
+    char* end = nullptr;
+    *v = std::strtoll(w.c_str(), &end, 10);
+    return !w.empty() && *end == '\0';
+  };
+  long long min = 0, max = 0, step = 0, subdim = 0;
+  const std::string problem = path + ": NRRD 'data file: " + h.dataFile + "': ";
+  CheckFileNamePattern(path, "NRRD 'data file: " + h.dataFile + "'", format);
+  if (count < 3 || !integer(words[0], &min) || !integer(words[1], &max) || !integer(words[2], &step))
+    throw InputError(problem + "a file-name pattern needs integers <min> <max> <step> after it");
+  if (count == 4 && (!integer(words[3], &subdim) || subdim < 1 || subdim > h.dimension))
+    throw InputError(problem + "<subdim> must be an axis count from 1 to the dimension");
+  const double files = ((double)max - (double)min) / (double)step + 1;  // in double: no overflow
+  if (step == 0 || files < 1) throw InputError(problem + "the step does not go from <min> to <max>");
+  double samples = 1;
+  for (int64_t n : h.sizes) samples *= (double)n;
+  if (files > samples)
+    throw InputError(problem + "more files than the volume has samples");
+}
+
 // The voxels the header promises against the bytes that hold them
 // (CheckDeclaredVoxelBytes), before vtkNrrdReader allocates for them. Data
 // split over several files (`data file: LIST` or a name pattern) is left to
-// the reader.
+// the reader, once a pattern's counter is checked.
 void CheckNrrdDataSize(const NrrdHeader& h, const std::string& path) {
+  if (!h.dataFile.empty() && h.dataFile.find(' ') != std::string::npos && h.dataFile.rfind("LIST", 0) != 0)
+    CheckNrrdFilePattern(h, path);
   if (h.typeSize == 0) return;
-  if (!h.dataFile.empty() && (h.dataFile.find(' ') != std::string::npos || h.dataFile == "LIST")) return;
+  if (!h.dataFile.empty() && (h.dataFile.find(' ') != std::string::npos || h.dataFile.rfind("LIST", 0) == 0)) return;
   double count = 1;
   for (int64_t n : h.sizes) count *= (double)n;
   std::error_code ec;

@@ -87,6 +87,13 @@ enum class DataEncoding { Raw, Compressed, Text };
 void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
                              DataEncoding encoding);
 
+// A printf format that names the files of a series (NRRD's `data file:
+// <format> ...`, MetaImage's `ElementDataFile = <pattern> ...`): both
+// readers pass it to a printf with one integer, so it must hold exactly one
+// integer conversion (%d, %03d, %i) and no other (a %s or %n would read or
+// write memory). Throws InputError naming `path` and `what`.
+void CheckFileNamePattern(const std::string& path, const std::string& what, const std::string& pattern);
+
 // Sends a warning to options.warn, or to stderr.
 void Warn(const VolumeLoadOptions& options, const std::string& message);
 

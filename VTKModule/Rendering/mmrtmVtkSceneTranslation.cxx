@@ -19,6 +19,8 @@
 #include <vtkSmartPointer.h>
 #include <vtkVolumeProperty.h>
 
+#include "scene_json.h"
+
 namespace mmrtm {
 namespace {
 
@@ -385,12 +387,7 @@ int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const P
 
 void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene) {
   const std::string where = "label " + std::to_string(label) + " material";
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(json);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(where + ": not JSON (" + e.what() + ")");
-  }
+  const nlohmann::json doc = ParseJson(json, where);
   if (!doc.is_object()) throw InputError(where + ": expected a JSON object");
   const int index = scene.MaterialIndex("label " + std::to_string(label));
   if (index < 0) return;

@@ -93,7 +93,7 @@ bool ChangeDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, Ch
 
 nlohmann::json ParseJson(const char* text)
 {
-  return nlohmann::json::parse(text ? text : "", nullptr, true, true);
+  return mmrtm::ParseJson(text ? text : "", "scene JSON");
 }
 }
 

@@ -1,5 +1,6 @@
 #include "scene_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -572,14 +573,52 @@ class Parser {
 
 }  // namespace
 
-json ReadJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open");
-  try {
-    return json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::exception& e) {  // a syntax error, or a number out of range ("1e999")
-    throw InputError(path + ": not valid JSON (" + e.what() + ")");
+namespace {
+
+// The deepest nesting of arrays and objects in JSON text, outside strings
+// and comments (an unbalanced text is the parser's to report).
+int NestingDepth(const std::string& text) {
+  int depth = 0, deepest = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '"') {
+      for (++i; i < text.size() && text[i] != '"'; ++i)
+        if (text[i] == '\\') ++i;
+    } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') {
+      i = text.find('\n', i);
+      if (i == std::string::npos) break;
+    } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+      i = text.find("*/", i + 2);
+      if (i == std::string::npos) break;
+      ++i;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
   }
+  return deepest;
+}
+
+}  // namespace
+
+json ParseJson(const std::string& text, const std::string& where) {
+  if (const int depth = NestingDepth(text); depth > kMaxJsonDepth)
+    throw InputError(where + ": JSON nested " + std::to_string(depth) + " levels deep (at most " +
+                     std::to_string(kMaxJsonDepth) + ")");
+  try {
+    return json::parse(text, nullptr, true, /*ignore_comments=*/true);
+  } catch (const json::exception& e) {  // a syntax error, or a number out of range ("1e999")
+    throw InputError(where + ": not valid JSON (" + e.what() + ")");
+  }
+}
+
+json ReadJsonFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParseJson(text.str(), path);
 }
 
 Scene SceneFromJson(const json& doc, SceneInputs inputs) { return Parser(doc, std::move(inputs)).Parse(); }

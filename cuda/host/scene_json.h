@@ -34,6 +34,14 @@ struct SceneInputs {
 // the line of a syntax error.
 nlohmann::json ReadJsonFile(const std::string& path);
 
+// Parses JSON text (comments allowed); throws InputError starting with
+// `where` on a syntax error, a number out of range or nesting deeper than
+// kMaxJsonDepth. The depth is checked first: the parser copes with any
+// depth, but copying or printing the document recurses once per level, and
+// a few million levels (a few MB of brackets) overflow the stack.
+nlohmann::json ParseJson(const std::string& text, const std::string& where);
+constexpr int kMaxJsonDepth = 100;  // scenes nest 6 deep
+
 // Builds a scene from a document. Every problem (unknown key, missing proxy,
 // TF without points, wrong type) throws InputError with the JSON path, e.g.
 // "materials.bone.tfs.density[0]: a transfer function needs at least one point".
