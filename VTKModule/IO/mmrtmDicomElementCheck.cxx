@@ -114,6 +114,11 @@ std::string CheckDicomElementLengths(const std::string& file) {
     }
     const bool big = !inMeta && syntax.bigEndian;
     const unsigned group = U16(b, big), element = U16(b + 2, big);
+    // The meta group is explicit VR by the standard; without a preamble
+    // GDCM asserts on one of its elements that has no VR (a fuzz finding).
+    if (inMeta && !part10 && !IsVr(b + 4))
+      return "element (" + Hex4(group) + "," + Hex4(element) + ") at byte " + std::to_string(pos) +
+             " of the file meta information has no value representation (corrupt)";
     uint64_t header = 8;
     uint64_t length = U32(b + 4, big);
     char vr[2] = {0, 0};
@@ -160,6 +165,9 @@ std::string CheckDicomElementLengths(const std::string& file) {
   // short. (A few bytes after a dataset are left alone: some writers pad.)
   if (pos < size && (inMeta || pos == 0 || pos + 8 <= size))
     return "the file ends inside a data element's header at byte " + std::to_string(pos) + " (truncated)";
+  // A file that ends with its meta group, no dataset after it: GDCM asserts
+  // reading the element it expects next (a fuzz finding).
+  if (inMeta) return "the file ends after its meta information (group 0002): no dataset follows (truncated)";
   return "";
 }
 

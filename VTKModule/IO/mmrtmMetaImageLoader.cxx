@@ -46,11 +46,21 @@ MetaImageHeader ReadMetaImageHeader(const std::string& path) {
   if (!in) throw InputError(path + ": cannot open");
   MetaImageHeader h;
   std::string line;
+  int number = 0;
   while (h.size < (1u << 20) && std::getline(in, line)) {
     h.size += line.size() + 1;
+    ++number;
+    // The header must read the same to metaio as to us: binary bytes in it
+    // (metaio then read on past them, to a later ElementDataFile a fuzz
+    // input put there) and a key given twice are errors.
+    for (unsigned char c : line)
+      if (c < 0x20 && c != '\t' && c != '\r')
+        throw InputError(path + ": line " + std::to_string(number) +
+                         " of the MetaImage header holds a control character (binary data in the header?)");
     const size_t eq = line.find('=');
     if (eq == std::string::npos) continue;
     const std::string key = Trim(line.substr(0, eq));
+    if (h.fields.count(key)) throw InputError(path + ": the MetaImage header gives " + key + " twice");
     h.fields[key] = Trim(line.substr(eq + 1));
     if (key == "ElementDataFile") break;
   }

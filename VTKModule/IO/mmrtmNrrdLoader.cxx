@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -135,12 +136,18 @@ std::vector<std::string> ReadNrrdHeaderLines(const std::string& path, int64_t* b
 NrrdHeader ParseNrrdHeader(const std::string& path) {
   NrrdHeader h;
   const std::vector<std::string> lines = ReadNrrdHeaderLines(path, &h.headerBytes);
+  std::set<std::string> seen;
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::string& line = lines[i];
     if (line[0] == '#') continue;
     const size_t colon = line.find(": ");
     if (colon == std::string::npos) continue;  // "key:=value" pairs and junk carry no geometry
     const std::string field = Trim(line.substr(0, colon)), value = Trim(line.substr(colon + 2));
+    // The format allows each field once; vtkNrrdReader acts on every copy
+    // as it reads it (a second `data file` line was formatted unchecked: a
+    // fuzz finding), so a repeated field is an error.
+    if (!seen.insert(field == "datafile" ? "data file" : field).second)
+      throw InputError(path + ": the NRRD header gives '" + field + "' twice");
     if (field == "dimension") {
       h.dimension = std::atoi(value.c_str());
     } else if (field == "sizes") {

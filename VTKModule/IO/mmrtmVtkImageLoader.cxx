@@ -2,7 +2,14 @@
 // points (.vtk).
 #include "mmrtmVolumeLoaderInternal.h"
 
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <sstream>
 #include <string>
 
 #include <vtkDataReader.h>
@@ -16,9 +23,97 @@ namespace mmrtm {
 // Scientific data without anatomy: the coordinates are taken as LPS as they
 // are. VTI files may carry a Direction matrix, which vtkImageData keeps.
 
+namespace {
+
+// An attribute's value in an XML start tag ("" when absent).
+std::string Attribute(const std::string& tag, const std::string& name) {
+  const std::regex pattern("\\s" + name + "=\"([^\"]*)\"");
+  std::smatch m;
+  return std::regex_search(tag, m, pattern) ? m[1].str() : std::string();
+}
+
+// vtkXMLDataParser dereferences null when the block header of compressed
+// appended data is inconsistent (an array's offset one byte off: a fuzz
+// finding). Reads every appended array's header first: for raw appended
+// data (not base64) each header must lie within the data, its block count
+// and sizes agree (block size above 0, the last block no larger), and its
+// compressed blocks end within the file. Anything else is the reader's.
+void CheckVtiAppendedData(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return;
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t appended = text.find("<AppendedData");
+  if (appended == std::string::npos) return;
+  const size_t appendedEnd = text.find('>', appended);
+  if (appendedEnd == std::string::npos || Attribute(text.substr(appended, appendedEnd - appended + 1), "encoding") != "raw")
+    return;
+  const size_t marker = text.find('_', appendedEnd);
+  if (marker == std::string::npos) return;
+  const size_t vtkFile = text.find("<VTKFile");
+  const std::string fileTag = vtkFile == std::string::npos ? "" : text.substr(vtkFile, text.find('>', vtkFile) - vtkFile + 1);
+  const bool compressed = !Attribute(fileTag, "compressor").empty();
+  const bool wide = Attribute(fileTag, "header_type") == "UInt64";
+  const bool bigEndian = Attribute(fileTag, "byte_order") == "BigEndian";
+  const uint64_t word = wide ? 8 : 4, data = marker + 1, size = text.size();
+  auto read = [&](uint64_t at) {
+    uint64_t v = 0;
+    for (uint64_t i = 0; i < word; ++i) {
+      const uint64_t byte = (unsigned char)text[at + (bigEndian ? i : word - 1 - i)];
+      v = v << 8 | byte;
+    }
+    return v;
+  };
+  // The most bytes an array can hold: the whole extent's points.
+  double points = 0;
+  {
+    std::istringstream extent(Attribute(text.substr(0, appended), "WholeExtent"));
+    double e[6];
+    if (extent >> e[0] >> e[1] >> e[2] >> e[3] >> e[4] >> e[5])
+      points = (e[1] - e[0] + 1) * (e[3] - e[2] + 1) * (e[5] - e[4] + 1);
+  }
+  auto typeSize = [](const std::string& type) {
+    if (type == "Int8" || type == "UInt8") return 1;
+    if (type == "Int16" || type == "UInt16") return 2;
+    if (type == "Int32" || type == "UInt32" || type == "Float32") return 4;
+    if (type == "Int64" || type == "UInt64" || type == "Float64") return 8;
+    return 0;  // strings, bits: not bounded here
+  };
+  const std::regex arrayTag("<DataArray[^>]*>");
+  for (auto it = std::sregex_iterator(text.begin(), text.begin() + (std::ptrdiff_t)appended, arrayTag);
+       it != std::sregex_iterator(); ++it) {
+    const std::string tag = it->str();
+    if (Attribute(tag, "format") != "appended") continue;
+    const std::string name = Attribute(tag, "Name"), offsetText = Attribute(tag, "offset");
+    const std::string problem = path + ": appended data of array '" + name + "' (offset " + offsetText + "): ";
+    char* end = nullptr;
+    const unsigned long long offset = std::strtoull(offsetText.c_str(), &end, 10);
+    if (offsetText.empty() || *end != '\0' || offset > size - data) throw InputError(problem + "the offset is past the end of the file");
+    const uint64_t at = data + offset;
+    if (!compressed) {
+      if (size - at < word || read(at) > size - at - word) throw InputError(problem + "its size runs past the end of the file");
+      continue;
+    }
+    if (size - at < 3 * word) throw InputError(problem + "the compression header runs past the end of the file");
+    const uint64_t blocks = read(at), blockSize = read(at + word), lastSize = read(at + 2 * word);
+    if (blocks > (size - at) / word - 3) throw InputError(problem + "the compression header runs past the end of the file");
+    const std::string components = Attribute(tag, "NumberOfComponents");
+    const double most = points * std::max(1, std::atoi(components.c_str())) * typeSize(Attribute(tag, "type"));
+    const double bytes = blocks == 0 ? 0.0 : double(blocks - 1) * double(blockSize) + double(lastSize ? lastSize : blockSize);
+    if (blocks == 0 || blockSize == 0 || lastSize > blockSize || (most > 0 && bytes > most))
+      throw InputError(problem + "the compression header's blocks (" + std::to_string(blocks) + " of " +
+                       std::to_string(blockSize) + " bytes) do not fit the array (corrupt)");
+    uint64_t total = 0;
+    for (uint64_t b = 0; b < blocks; ++b) total += read(at + (3 + b) * word);
+    if (total > size - at - (3 + blocks) * word) throw InputError(problem + "the compressed blocks run past the end of the file");
+  }
+}
+
+}  // namespace
+
 void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/) {
   vtkNew<vtkXMLImageDataReader> reader;
   if (!reader->CanReadFile(path.c_str())) throw InputError(path + ": not a VTK XML ImageData file");
+  CheckVtiAppendedData(path);
   reader->SetFileName(path.c_str());
   vtkImageData* image = RunReader(reader, path);
   StoreImageVoxels(image, path, Rescale{}, out);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -39,8 +40,19 @@ void CheckKeys(const json& obj, const std::string& where, std::initializer_list<
 float Number(const json& v, const std::string& where) {
   if (!v.is_number()) Fail(where, "expected a number");
   double d = v.get<double>();
-  if (!std::isfinite(d)) Fail(where, "expected a finite number");
+  // A double beyond float's range would be infinite in the scene (a fuzz
+  // finding: a light colour of 1e108 put NaN into the image).
+  if (!(std::fabs(d) <= std::numeric_limits<float>::max())) Fail(where, "expected a finite number within float range");
   return (float)d;
+}
+
+// A light's radiance (colour x intensity): at most kMaxRadiance per channel.
+RGB Radiance(const RGB& color, float intensity, const std::string& where) {
+  const RGB L = color * intensity;
+  for (int c = 0; c < 3; ++c)
+    if (!(std::fabs(L[c]) <= kMaxRadiance))
+      Fail(where, "colour x intensity must stay within 1e20 (the film would overflow)");
+  return L;
 }
 
 float NumberOr(const json& obj, const char* key, float fallback, const std::string& where) {
@@ -447,7 +459,7 @@ class Parser {
         CheckKeys(lj, w, {"type", "direction", "camera_azimuth", "camera_elevation", "color", "intensity"});
         Light l;
         l.type = LightType::Directional;
-        l.L = color * intensity;
+        l.L = Radiance(color, intensity, w);
         if (lj.contains("direction")) {
           Vec3 d = Vector(lj["direction"], w + ".direction");
           if (!(Length(d) > 0.f)) Fail(w + ".direction", "must not be zero");
@@ -464,19 +476,20 @@ class Parser {
         Light l;
         l.type = LightType::Point;
         l.vector = Vector(lj["position"], w + ".position");
-        l.L = color * intensity;
+        l.L = Radiance(color, intensity, w);
         scene_.lights.push_back(l);
       } else if (type == "environment") {
         CheckKeys(lj, w, {"type", "file", "sky", "color", "intensity"});
         if (scene_.environment) Fail(w, "only one environment light is supported");
         if (lj.contains("file")) {
-          scene_.environment = EnvironmentMap::Load(Resolve(StringOr(lj, "file", "", w), in_.baseDirectory), intensity);
+          scene_.environment =
+              EnvironmentMap::Load(Resolve(StringOr(lj, "file", "", w), in_.baseDirectory), Radiance(RGB(1.f), intensity, w)[0]);
         } else if (lj.contains("color")) {
-          scene_.environment = EnvironmentMap::Constant(color * intensity);
+          scene_.environment = EnvironmentMap::Constant(Radiance(color, intensity, w));
         } else {
           const std::string sky = StringOr(lj, "sky", "default", w);
           if (sky != "default") Fail(w + ".sky", "the only built-in sky is 'default'");
-          scene_.environment = EnvironmentMap::DefaultSky(intensity);
+          scene_.environment = EnvironmentMap::DefaultSky(Radiance(RGB(1.f), intensity, w)[0]);
         }
       } else {
         Fail(w + ".type", "expected directional, point or environment, got '" + type + "'");

@@ -19,6 +19,15 @@ namespace mmrtm {
 constexpr int kMaxProxies = 4;
 // The largest optical depth one voxel may have (Classifier::maxExtinction).
 constexpr float kMaxOpticalDepthPerVoxel = 64.f;
+// The largest radiance a light or an emitting material may give: beyond it
+// (a typo, not a scene) the film's float sums would overflow to infinity.
+// Lights above it are an error in the scene format; emission is clamped to
+// [0, kMaxRadiance] (a product of a base and TF values can exceed it).
+constexpr float kMaxRadiance = 1e20f;
+
+// Emission bounded to [0, kMaxRadiance]; NaN (an overflowed product times
+// 0) is 0.
+MMRTM_CPU_GPU inline float BoundedEmission(float x) { return x > 0.f ? (x < kMaxRadiance ? x : kMaxRadiance) : 0.f; }
 
 struct ProxySamples {
   float v[kMaxProxies] = {};
@@ -165,7 +174,7 @@ struct Classifier {
     out.roughness = Clamp(k[4], 0.f, 1.f);
     out.metallic = Clamp(k[5], 0.f, 1.f);
     out.surfaceProbability = Clamp(k[6], 0.f, 1.f);
-    out.emission = RGB(k[7], k[8], k[9]);
+    out.emission = RGB(BoundedEmission(k[7]), BoundedEmission(k[8]), BoundedEmission(k[9]));
     out.g = Clamp(k[10], -0.99f, 0.99f);
     return out;
   }
