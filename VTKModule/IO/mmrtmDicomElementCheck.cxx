@@ -65,6 +65,29 @@ std::optional<Syntax> GuessSyntax(const unsigned char* first) {
   return std::nullopt;
 }
 
+// A JPEG 2000 codestream (a fragment of encapsulated pixel data that starts
+// with the SOC and SIZ markers) must have the image size the dataset states:
+// OpenJPEG allocates the size its SIZ marker promises (one flipped bit of
+// Xsiz made it ask for 2 GB for a 512 x 512 slice: a fuzz finding). ""
+// when it agrees, or for a fragment that is not the start of a codestream.
+std::string CheckJpeg2000Size(std::ifstream& in, uint64_t pos, unsigned rows, unsigned columns, unsigned samples) {
+  unsigned char m[42];
+  in.clear();
+  in.seekg((std::streamoff)pos);
+  if (!in.read(reinterpret_cast<char*>(m), sizeof m)) return "";
+  if (!(m[0] == 0xFF && m[1] == 0x4F && m[2] == 0xFF && m[3] == 0x51)) return "";
+  const uint32_t x = U32(m + 8, true), y = U32(m + 12, true), x0 = U32(m + 16, true), y0 = U32(m + 20, true);
+  const uint32_t tileX = U32(m + 24, true), tileY = U32(m + 28, true);
+  const unsigned components = U16(m + 40, true);
+  const uint64_t width = x > x0 ? x - x0 : 0, height = y > y0 ? y - y0 : 0;
+  if (tileX == 0 || tileY == 0 || width != columns || height != rows || components != samples)
+    return "its JPEG 2000 codestream says " + std::to_string(width) + " x " + std::to_string(height) + " x " +
+           std::to_string(components) + " samples (tiles " + std::to_string(tileX) + " x " + std::to_string(tileY) +
+           ") where the dataset says " + std::to_string(columns) + " x " + std::to_string(rows) + " x " +
+           std::to_string(samples) + " (corrupt)";
+  return "";
+}
+
 }  // namespace
 
 std::string CheckDicomElementLengths(const std::string& file) {
@@ -100,6 +123,7 @@ std::string CheckDicomElementLengths(const std::string& file) {
   }
   bool fragments = false;  // inside encapsulated pixel data
   std::string transferSyntax;
+  unsigned rows = 0, columns = 0, samples = 1;  // (0028,0010), (0028,0011), (0028,0002) as read
   while (pos + 8 <= size) {
     if (!readAt(pos, 8)) return "";
     if (inMeta && U16(b, false) != 0x0002) {
@@ -142,6 +166,10 @@ std::string CheckDicomElementLengths(const std::string& file) {
       continue;
     }
     if (group == 0xFFFE && element == 0xE0DD) fragments = false;  // a sequence delimiter ends them
+    if (fragments && group == 0xFFFE && element == 0xE000 && length >= 42 && length <= size - pos) {
+      const std::string problem = CheckJpeg2000Size(in, pos, rows, columns, samples);
+      if (!problem.empty()) return where + ": " + problem;
+    }
     if (length == 0xFFFFFFFFu) continue;  // undefined length: its items and delimiters follow
     if (length > size - pos)
       return where + " says its value is " + std::to_string(length) + " bytes, but only " +
@@ -151,6 +179,11 @@ std::string CheckDicomElementLengths(const std::string& file) {
     if ((group == 0xFFFE && !fragments) || (vr[0] == 'S' && vr[1] == 'Q')) continue;
     if (!vr[0] && length >= 8 && readAt(pos, 4) && U16(b, big) == 0xFFFE && U16(b + 2, big) == 0xE000)
       continue;  // a sequence in implicit VR: its first item follows
+    if (group == 0x0028 && (element == 0x0010 || element == 0x0011 || element == 0x0002) && length == 2 &&
+        readAt(pos, 2)) {
+      const unsigned value = U16(b, big);
+      (element == 0x0010 ? rows : element == 0x0011 ? columns : samples) = value;
+    }
     if (group == 0x0002 && element == 0x0010 && length <= 64) {
       char uid[65] = {};
       in.clear();
