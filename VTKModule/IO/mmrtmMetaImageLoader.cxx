@@ -215,6 +215,15 @@ void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& 
   }
   CheckDeclaredVoxelBytes(path, count * size, count, d->fileSize > d->offset ? double(d->fileSize - d->offset) : 0.0,
                           d->compressed ? DataEncoding::Compressed : DataEncoding::Raw);
+  // metaio loops forever on some damaged zlib streams (a fuzz finding), so
+  // the stream is inflated here first (counting, not keeping): it must be
+  // whole and hold every voxel. CheckMetaImageData then need not.
+  if (d->compressed) {
+    const uint64_t inflated = Inflate(d->file, d->offset, path);  // throws when damaged or cut short
+    if ((double)inflated < count * size)
+      throw InputError(path + ": voxel data is " + std::to_string(inflated) + " bytes, expected " +
+                       std::to_string((uint64_t)(count * size)) + " (truncated?)");
+  }
 }
 
 // metaio reports a short or damaged data file only on the console and
@@ -248,8 +257,8 @@ void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint8
                       "leave garbage), so the whole stream was inflated and checked");
     return;
   }
-  const uint64_t available =
-      compressed ? Inflate(dataFile, offset, path) : (fileSize > offset ? fileSize - offset : 0);
+  if (compressed) return;  // inflated and counted before the read (CheckMetaImageDeclaredSize)
+  const uint64_t available = fileSize > offset ? fileSize - offset : 0;
   if (available < bytes)
     throw InputError(path + ": voxel data is " + std::to_string(available) + " bytes, expected " +
                      std::to_string(bytes) + " (truncated?)");
