@@ -53,7 +53,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     inputs.volumes["scalars"] = SyntheticVolume("input.nrrd", "scalars", mmrtm::Interpolation::Trilinear);
     inputs.volumes["labels"] = SyntheticVolume("labels.nrrd", "labels", mmrtm::Interpolation::Nearest);
     mmrtm::Scene scene = mmrtm::SceneFromJson(mmrtm::ReadJsonFile(path), inputs);
-    // What the parser promises of the settings it accepts.
+    // Built as mmrtm-render builds it (one grid thread): Build validates the
+    // settings (spp 0 is refused there, not by the parser).
+    scene.render.accelerator.grid.threads = 1;
+    scene.Build();
+    // What the parser and Build promise of the settings they accept.
     const mmrtm::RenderSettings& r = scene.render;
     Require(r.width >= 1 && r.height >= 1 && r.samplesPerPixel >= 1 && r.threads >= 0);
     Require(std::isfinite(r.exposure) && r.integrator.maxBounces >= 0);

@@ -142,12 +142,19 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
     if (line[0] == '#') continue;
     const size_t colon = line.find(": ");
     if (colon == std::string::npos) continue;  // "key:=value" pairs and junk carry no geometry
-    const std::string field = Trim(line.substr(0, colon)), value = Trim(line.substr(colon + 2));
+    // The field as vtkNrrdReader matches it: exactly, not trimmed.
+    const std::string field = line.substr(0, colon), value = Trim(line.substr(colon + 2));
     // The format allows each field once; vtkNrrdReader acts on every copy
     // as it reads it (a second `data file` line was formatted unchecked: a
     // fuzz finding), so a repeated field is an error.
     if (!seen.insert(field == "datafile" ? "data file" : field).second)
       throw InputError(path + ": the NRRD header gives '" + field + "' twice");
+    // The format puts `dimension` before every per-axis field; vtkNrrdReader
+    // crashes on `sizes` before it (a fuzz finding).
+    static const char* kPerAxis[] = {"sizes", "spacings", "thicknesses", "axis mins", "axismins", "axis maxs",
+                                     "axismaxs", "centers", "centerings", "labels", "units", "kinds", "space directions"};
+    if (!seen.count("dimension") && std::find(std::begin(kPerAxis), std::end(kPerAxis), field) != std::end(kPerAxis))
+      throw InputError(path + ": the NRRD header gives '" + field + "' before 'dimension' (the format wants dimension first)");
     if (field == "dimension") {
       h.dimension = std::atoi(value.c_str());
     } else if (field == "sizes") {
@@ -176,6 +183,8 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
     }
   }
   if (h.encoding.empty()) h.encoding = "raw";
+  // vtkNrrdReader reads voxels of no type into a null buffer (a fuzz finding).
+  if (h.typeSize == 0) throw InputError(path + ": the NRRD header has no 'type' of a known kind");
   if (h.dimension <= 0 || (int)h.sizes.size() != h.dimension)
     throw InputError(path + ": NRRD header has no valid 'dimension' and 'sizes'");
   if (h.hasSpaceDirections && (int)h.directions.size() != h.dimension)

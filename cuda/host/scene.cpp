@@ -96,6 +96,7 @@ void Scene::Validate() const {
   if (r.width <= 0 || r.height <= 0 || r.width > 16384 || r.height > 16384)
     throw InputError("render: image size must be between 1 and 16384 pixels");
   if (r.samplesPerPixel <= 0) throw InputError("render: samples per pixel must be positive");
+  if (r.threads < 0 || r.threads > 1024) throw InputError("render: threads must be 0 (all) to 1024");
   if (!(r.integrator.shadowExtinctionScale > 0.f && r.integrator.shadowExtinctionScale <= 1.f))
     throw InputError("render: shadow extinction scale must be in (0, 1]");
   if (!(r.integrator.rayMarchStep > 0.f)) throw InputError("render: ray marching step must be positive");
