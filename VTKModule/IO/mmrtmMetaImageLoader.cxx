@@ -189,6 +189,17 @@ void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& 
   // bytes (found by fuzzing).
   if (Trim(Field(h, "ElementDataFile")).empty())
     throw InputError(path + ": the MetaImage header names no ElementDataFile (LOCAL, or the data's file)");
+  // metaio splits a LIST or pattern ElementDataFile into words of at most
+  // 79 characters (METAIO_MAX_WORD_SIZE buffers) and joins a pattern's
+  // words into the first: longer ones overflow its heap (a fuzz finding).
+  const std::string dataFile = Field(h, "ElementDataFile");
+  if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos) {
+    std::istringstream words(dataFile);
+    for (std::string w; words >> w;)
+      if (w.size() >= 80 || (dataFile.find('%') != std::string::npos && dataFile.size() >= 80))
+        throw InputError(path + ": ElementDataFile '" + dataFile.substr(0, 100) +
+                         "': a file list or pattern of 80 characters or more (metaio's limit)");
+  }
   if (Field(h, "ElementDataFile").find('%') != std::string::npos) {
     const std::vector<double> dims = ParseNumbers(Field(h, "DimSize"));
     if (dims.empty() || !(dims.back() >= 1 && dims.back() <= 2147483647.0))
