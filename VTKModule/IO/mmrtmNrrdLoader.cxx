@@ -158,8 +158,13 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
     if (field == "dimension") {
       h.dimension = std::atoi(value.c_str());
     } else if (field == "sizes") {
-      for (double v : ParseNumbers(value)) {
-        if (!(v >= 1 && v <= std::numeric_limits<int>::max() && v == std::floor(v)))
+      // Every word a positive integer: vtkNrrdReader reads "2t" as a size
+      // too and then reads voxels into a null buffer (a fuzz finding).
+      std::istringstream words(value);
+      for (std::string w; words >> w;) {
+        char* end = nullptr;
+        const long long v = std::strtoll(w.c_str(), &end, 10);
+        if (*end != '\0' || v < 1 || v > std::numeric_limits<int>::max())
           throw InputError(path + ": NRRD 'sizes' must be positive integers: " + value);
         h.sizes.push_back((int64_t)v);
       }

@@ -82,7 +82,12 @@ void CheckVtiAppendedData(const std::string& path) {
   for (auto it = std::sregex_iterator(text.begin(), text.begin() + (std::ptrdiff_t)appended, arrayTag);
        it != std::sregex_iterator(); ++it) {
     const std::string tag = it->str();
-    if (Attribute(tag, "format") != "appended") continue;
+    // vtkXMLReader reads any other word as appended (a fuzz finding).
+    const std::string format = Attribute(tag, "format");
+    if (format != "ascii" && format != "binary" && format != "appended")
+      throw InputError(path + ": DataArray '" + Attribute(tag, "Name") + "' has format '" + format +
+                       "' (ascii, binary or appended)");
+    if (format != "appended") continue;
     const std::string name = Attribute(tag, "Name"), offsetText = Attribute(tag, "offset");
     const std::string problem = path + ": appended data of array '" + name + "' (offset " + offsetText + "): ";
     char* end = nullptr;
