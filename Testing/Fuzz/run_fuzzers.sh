@@ -16,6 +16,13 @@
 # same sequence of inputs on every machine, and a longer run here covers a
 # shorter one in CI.
 #
+# MMRTM_FUZZ_FAIL_ON=ours (ctest's fuzz-short) fails only on findings whose
+# first stack frame is the project's code (classify_finding.py): the
+# readers of VTK, metaio and GDCM give a new crash every few seconds of a
+# fresh run (Documentation/reliability.md has the figures), which would
+# block every change; those are printed, and fixed by pre-checks from the
+# longer runs here. The default, all, fails on any finding.
+#
 # Usage: run_fuzzers.sh SOURCE_DIR BUILD_DIR SECONDS [TARGET...]
 # Writes BUILD/fuzz-summary.tsv: target, executions, corpus files, coverage
 # (edges), features, findings.
@@ -99,7 +106,13 @@ for target in "${targets[@]}"; do
   printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$target" "${runs:-?}" "$corpus" "${cov:-?}" "${ft:-?}" "$findings" \
     >> "$build/fuzz-summary.tsv"
   if [ "$findings" -ne 0 ]; then
-    failed=1
+    owner=$(/usr/bin/python3 "$here/classify_finding.py" "$log")
+    if [ "${MMRTM_FUZZ_FAIL_ON:-all}" = ours ] && [ "${owner%%:*}" = third-party ]; then
+      echo "=== fuzz-$target: a finding in a third-party library, reported, not failing (MMRTM_FUZZ_FAIL_ON=ours) ==="
+      echo "=== $owner"
+    else
+      failed=1
+    fi
     echo "=== fuzz-$target: a finding (input in $build/artifacts/$target/) ==="
     grep -E -A30 'ERROR|==[0-9]+==|terminate called|deadly signal|Sanitizer' "$log" | head -60 || tail -30 "$log"
   fi

@@ -185,6 +185,17 @@ void CheckMetaImageFilePattern(const std::string& path, const std::string& value
 // the data that holds them (CheckDeclaredVoxelBytes), and the data file is
 // there (metaio leaks its buffers when it is not: found by fuzzing).
 void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& h) {
+  // Every word of DimSize a positive integer: metaio reads "1-6" as a size
+  // and allocated a negative number of bytes (a fuzz finding).
+  {
+    std::istringstream words(Field(h, "DimSize"));
+    for (std::string w; words >> w;) {
+      char* end = nullptr;
+      const long long v = std::strtoll(w.c_str(), &end, 10);
+      if (*end != '\0' || v < 1 || v > 2147483647LL)
+        throw InputError(path + ": DimSize must be positive integers: " + Field(h, "DimSize"));
+    }
+  }
   // metaio reads an empty ElementDataFile as a stream it then sizes as -1
   // bytes (found by fuzzing).
   if (Trim(Field(h, "ElementDataFile")).empty())
