@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <vtkDataReader.h>
 #include <vtkFieldData.h>
@@ -39,28 +39,41 @@ std::string Attribute(const std::string& tag, const std::string& name) {
 // and sizes agree (block size above 0, the last block no larger), and its
 // compressed blocks end within the file. Anything else is the reader's.
 void CheckVtiAppendedData(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return;
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const size_t appended = text.find("<AppendedData");
-  if (appended == std::string::npos) return;
-  const size_t appendedEnd = text.find('>', appended);
-  if (appendedEnd == std::string::npos || Attribute(text.substr(appended, appendedEnd - appended + 1), "encoding") != "raw")
-    return;
-  const size_t marker = text.find('_', appendedEnd);
-  if (marker == std::string::npos) return;
+  const uint64_t size = (uint64_t)in.tellg();
+  in.seekg(0);
+  // Only the XML before the appended data is read as text (at most 16 MiB
+  // of it), then each array's header where it lies: a large file is not
+  // read twice.
+  std::string text;
+  size_t appended = std::string::npos, appendedEnd = std::string::npos, marker = std::string::npos;
+  std::vector<char> chunk(1 << 16);
+  while (text.size() < (16u << 20)) {
+    in.read(chunk.data(), (std::streamsize)chunk.size());
+    if (in.gcount() <= 0) break;
+    text.append(chunk.data(), (size_t)in.gcount());
+    if (appended == std::string::npos) appended = text.find("<AppendedData");
+    if (appended != std::string::npos && appendedEnd == std::string::npos) appendedEnd = text.find('>', appended);
+    if (appendedEnd != std::string::npos) marker = text.find('_', appendedEnd);
+    if (marker != std::string::npos) break;
+  }
+  if (marker == std::string::npos) return;  // no raw appended data (or its XML is huge): the reader's to judge
+  if (Attribute(text.substr(appended, appendedEnd - appended + 1), "encoding") != "raw") return;
   const size_t vtkFile = text.find("<VTKFile");
   const std::string fileTag = vtkFile == std::string::npos ? "" : text.substr(vtkFile, text.find('>', vtkFile) - vtkFile + 1);
   const bool compressed = !Attribute(fileTag, "compressor").empty();
   const bool wide = Attribute(fileTag, "header_type") == "UInt64";
   const bool bigEndian = Attribute(fileTag, "byte_order") == "BigEndian";
-  const uint64_t word = wide ? 8 : 4, data = marker + 1, size = text.size();
+  const uint64_t word = wide ? 8 : 4, data = marker + 1;
+  // The header word at byte `at` of the file (within the file: checked by the caller).
   auto read = [&](uint64_t at) {
+    unsigned char bytes[8] = {};
+    in.clear();
+    in.seekg((std::streamoff)at);
+    in.read(reinterpret_cast<char*>(bytes), (std::streamsize)word);
     uint64_t v = 0;
-    for (uint64_t i = 0; i < word; ++i) {
-      const uint64_t byte = (unsigned char)text[at + (bigEndian ? i : word - 1 - i)];
-      v = v << 8 | byte;
-    }
+    for (uint64_t i = 0; i < word; ++i) v = v << 8 | bytes[bigEndian ? i : word - 1 - i];
     return v;
   };
   // The most bytes an array can hold: the whole extent's points.
