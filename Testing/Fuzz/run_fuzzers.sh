@@ -12,9 +12,8 @@
 # (ctest then replays it in every build) and fix the code.
 #
 # Runs are deterministic: libFuzzer's seed is MMRTM_FUZZ_SEED (default 1; 0
-# picks one at random), so a run from an empty corpus is the start of the
-# same sequence of inputs on every machine, and a longer run here covers a
-# shorter one in CI.
+# picks one at random), so a run from an empty corpus of the same code
+# repeats its inputs and a finding can be replayed.
 #
 # MMRTM_FUZZ_FAIL_ON=ours (ctest's fuzz-short) fails only on findings whose
 # first stack frame is the project's code (classify_finding.py): the
