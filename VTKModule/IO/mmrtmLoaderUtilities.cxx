@@ -202,6 +202,24 @@ void CheckMemoryAvailable(const std::string& path, double bytes, const std::stri
                      HumanBytes(available) + " of memory available; nothing was allocated");
 }
 
+std::optional<long long> IntegerWord(const std::string& word) {
+  char* end = nullptr;
+  const long long v = std::strtoll(word.c_str(), &end, 10);
+  if (word.empty() || *end != '\0' || std::llabs(v) > std::numeric_limits<int>::max()) return std::nullopt;
+  return v;
+}
+
+std::vector<int64_t> PositiveIntegers(const std::string& path, const std::string& what, const std::string& value) {
+  std::vector<int64_t> numbers;
+  std::istringstream words(value);
+  for (std::string w; words >> w;) {
+    const std::optional<long long> v = IntegerWord(w);
+    if (!v || *v < 1) throw InputError(path + ": " + what + " must be positive integers: " + value);
+    numbers.push_back(*v);
+  }
+  return numbers;
+}
+
 void CheckFileNamePattern(const std::string& path, const std::string& what, const std::string& pattern) {
   int conversions = 0;
   for (size_t i = 0; i < pattern.size(); ++i) {

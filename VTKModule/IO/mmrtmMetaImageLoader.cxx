@@ -187,35 +187,22 @@ void CheckMetaImageFilePattern(const std::string& path, const std::string& value
 void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& h) {
   // Every word of DimSize a positive integer: metaio reads "1-6" as a size
   // and allocated a negative number of bytes (a fuzz finding).
-  {
-    std::istringstream words(Field(h, "DimSize"));
-    for (std::string w; words >> w;) {
-      char* end = nullptr;
-      const long long v = std::strtoll(w.c_str(), &end, 10);
-      if (*end != '\0' || v < 1 || v > 2147483647LL)
-        throw InputError(path + ": DimSize must be positive integers: " + Field(h, "DimSize"));
-    }
-  }
+  const std::vector<int64_t> dims = PositiveIntegers(path, "DimSize", Field(h, "DimSize"));
   // metaio reads an empty ElementDataFile as a stream it then sizes as -1
   // bytes (found by fuzzing).
-  if (Trim(Field(h, "ElementDataFile")).empty())
+  const std::string dataFile = Trim(Field(h, "ElementDataFile"));
+  if (dataFile.empty())
     throw InputError(path + ": the MetaImage header names no ElementDataFile (LOCAL, or the data's file)");
-  // metaio splits a LIST or pattern ElementDataFile into words of at most
-  // 79 characters (METAIO_MAX_WORD_SIZE buffers) and joins a pattern's
-  // words into the first: longer ones overflow its heap (a fuzz finding).
-  const std::string dataFile = Field(h, "ElementDataFile");
-  if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos) {
-    std::istringstream words(dataFile);
-    for (std::string w; words >> w;)
-      if (w.size() >= 80 || (dataFile.find('%') != std::string::npos && dataFile.size() >= 80))
-        throw InputError(path + ": ElementDataFile '" + dataFile.substr(0, 100) +
-                         "': a file list or pattern of 80 characters or more (metaio's limit)");
-  }
-  if (Field(h, "ElementDataFile").find('%') != std::string::npos) {
-    const std::vector<double> dims = ParseNumbers(Field(h, "DimSize"));
-    if (dims.empty() || !(dims.back() >= 1 && dims.back() <= 2147483647.0))
-      throw InputError(path + ": DimSize must be positive integers");
-    CheckMetaImageFilePattern(path, Field(h, "ElementDataFile"), dims.back());
+  // metaio splits a LIST or pattern ElementDataFile into words in 80-byte
+  // buffers and joins a pattern's words into the first: 80 characters or
+  // more overflow its heap (a fuzz finding).
+  const bool pattern = dataFile.find('%') != std::string::npos;
+  if ((pattern || dataFile.rfind("LIST", 0) == 0) && dataFile.size() >= 80)
+    throw InputError(path + ": ElementDataFile '" + dataFile.substr(0, 100) +
+                     "': a file list or pattern of 80 characters or more (metaio's limit)");
+  if (pattern) {
+    if (dims.empty()) throw InputError(path + ": a file-name pattern needs DimSize");
+    CheckMetaImageFilePattern(path, dataFile, (double)dims.back());
   }
   const std::optional<MetaImageData> d = LocateMetaImageData(path, h);
   // metaio allocates CompressedDataSize bytes before reading them.
@@ -228,13 +215,9 @@ void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& 
                        std::to_string((uint64_t)available) + " (truncated, or a corrupt header)");
   }
   const int size = MetaElementSize(Field(h, "ElementType"));
-  const std::vector<double> dims = ParseNumbers(Field(h, "DimSize"));
   if (!d || size == 0 || dims.empty()) return;
   double count = std::max(1.0, std::atof(Field(h, "ElementNumberOfChannels").c_str()));
-  for (double n : dims) {
-    if (!(n >= 1 && n <= 2147483647.0)) throw InputError(path + ": DimSize must be positive integers");
-    count *= n;
-  }
+  for (int64_t n : dims) count *= (double)n;
   CheckDeclaredVoxelBytes(path, count * size, count, d->fileSize > d->offset ? double(d->fileSize - d->offset) : 0.0,
                           d->compressed ? DataEncoding::Compressed : DataEncoding::Raw);
   // metaio loops forever on some damaged zlib streams (a fuzz finding), so

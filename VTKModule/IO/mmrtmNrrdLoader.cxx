@@ -160,14 +160,7 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
     } else if (field == "sizes") {
       // Every word a positive integer: vtkNrrdReader reads "2t" as a size
       // too and then reads voxels into a null buffer (a fuzz finding).
-      std::istringstream words(value);
-      for (std::string w; words >> w;) {
-        char* end = nullptr;
-        const long long v = std::strtoll(w.c_str(), &end, 10);
-        if (*end != '\0' || v < 1 || v > std::numeric_limits<int>::max())
-          throw InputError(path + ": NRRD 'sizes' must be positive integers: " + value);
-        h.sizes.push_back((int64_t)v);
-      }
+      h.sizes = PositiveIntegers(path, "NRRD 'sizes'", value);
     } else if (field == "space") {
       h.space = ToLower(value);
     } else if (field == "encoding") {
@@ -212,9 +205,9 @@ void CheckNrrdFilePattern(const NrrdHeader& h, const std::string& path) {
   // Within int: vtkNrrdReader reads them as int (a step of 8.9e72 became a
   // garbage step that added names until memory ran out: a fuzz finding).
   auto integer = [](const std::string& w, long long* v) {
-    char* end = nullptr;
-    *v = std::strtoll(w.c_str(), &end, 10);
-    return !w.empty() && *end == '\0' && std::llabs(*v) <= std::numeric_limits<int>::max();
+    const std::optional<long long> parsed = IntegerWord(w);
+    if (parsed) *v = *parsed;
+    return parsed.has_value();
   };
   long long min = 0, max = 0, step = 0, subdim = 0;
   const std::string problem = path + ": NRRD 'data file: " + h.dataFile + "': ";
@@ -246,7 +239,6 @@ void CheckNrrdDataSize(const NrrdHeader& h, const std::string& path) {
   while (words >> word) ++wordCount;
   const bool list = first == "LIST", pattern = !list && wordCount >= 4;
   if (pattern) CheckNrrdFilePattern(h, path);
-  if (h.typeSize == 0) return;
   if (list || pattern) return;
   double count = 1;
   for (int64_t n : h.sizes) count *= (double)n;

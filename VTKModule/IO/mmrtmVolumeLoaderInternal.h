@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,16 @@ std::string Trim(const std::string& s);
 
 // Whitespace-separated numbers; stops at the first token that is not one.
 std::vector<double> ParseNumbers(const std::string& text);
+
+// A whole word as an integer within int's range, as the readers (VTK,
+// metaio) parse these fields; nullopt for anything else ("2t", "1-6",
+// "8e72"): those readers take such words as numbers anyway and crash.
+std::optional<long long> IntegerWord(const std::string& word);
+
+// Every word of a header field (sizes, DimSize) as a positive integer
+// within int's range; throws InputError "PATH: WHAT must be positive
+// integers: VALUE" otherwise.
+std::vector<int64_t> PositiveIntegers(const std::string& path, const std::string& what, const std::string& value);
 
 Vec3d Cross(const Vec3d& a, const Vec3d& b);
 double Dot(const Vec3d& a, const Vec3d& b);

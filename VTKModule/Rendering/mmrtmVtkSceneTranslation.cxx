@@ -90,40 +90,37 @@ namespace {
 class FiniteFunctions {
  public:
   vtkPiecewiseFunction* Of(vtkPiecewiseFunction* f) {
-    if (!f || Finite(f, 4)) return f;
-    vtkNew<vtkPiecewiseFunction> copy;
-    copy->DeepCopy(f);
-    copy->RemoveAllPoints();
-    double node[4];
-    for (int i = 0; i < f->GetSize(); ++i) {
-      f->GetNodeValue(i, node);
-      if (Repair(node, 4)) copy->AddPoint(node[0], node[1], node[2], node[3]);
-    }
-    keep_.emplace_back(copy.Get());
-    return copy;
+    return Repaired<4>(f, [](vtkPiecewiseFunction* c, const double* n) { c->AddPoint(n[0], n[1], n[2], n[3]); });
   }
   vtkColorTransferFunction* Of(vtkColorTransferFunction* f) {
-    if (!f || Finite(f, 6)) return f;
-    vtkNew<vtkColorTransferFunction> copy;
-    copy->DeepCopy(f);
-    copy->RemoveAllPoints();
-    double node[6];
-    for (int i = 0; i < f->GetSize(); ++i) {
-      f->GetNodeValue(i, node);
-      if (Repair(node, 6)) copy->AddRGBPoint(node[0], node[1], node[2], node[3], node[4], node[5]);
-    }
-    keep_.emplace_back(copy.Get());
-    return copy;
+    return Repaired<6>(
+        f, [](vtkColorTransferFunction* c, const double* n) { c->AddRGBPoint(n[0], n[1], n[2], n[3], n[4], n[5]); });
   }
   int replaced = 0;  // node values read as 0, nodes dropped
 
  private:
-  template <class F>
-  static bool Finite(F* f, int count) {
-    double node[6];
+  // `f`, or a copy with its nodes (Count doubles each) repaired and added
+  // back by `add`.
+  template <int Count, class F, class Add>
+  F* Repaired(F* f, Add add) {
+    if (!f || Finite<Count>(f)) return f;
+    vtkNew<F> copy;
+    copy->DeepCopy(f);
+    copy->RemoveAllPoints();
+    double node[Count];
     for (int i = 0; i < f->GetSize(); ++i) {
       f->GetNodeValue(i, node);
-      for (int k = 0; k < count; ++k)
+      if (Repair(node, Count)) add(copy.Get(), node);
+    }
+    keep_.emplace_back(copy.Get());
+    return copy;
+  }
+  template <int Count, class F>
+  static bool Finite(F* f) {
+    double node[Count];
+    for (int i = 0; i < f->GetSize(); ++i) {
+      f->GetNodeValue(i, node);
+      for (int k = 0; k < Count; ++k)
         if (!std::isfinite(node[k])) return false;
     }
     return true;

@@ -86,9 +86,9 @@ struct ProxyLayout {
 // material wins where its opacity is above zero, DESIGN.md's priority rule).
 // Values that are not finite are read as 0: a NaN node value of a transfer
 // function is 0 at its node (its neighbours still ramp to it; a node at a
-// NaN position is dropped), a NaN unit distance is VTK's default 1, any
-// other NaN reaching the scene (a component weight) is 0. Returns how many
-// there were, for the caller to warn about.
+// NaN position is dropped), any other NaN reaching the scene (a component
+// weight) is 0; returns how many there were, for the caller to warn about.
+// (A NaN unit distance is VTK's default 1, without a warning.)
 int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
 
 // Gives label `label`'s material (made by SetMaterialsFromProperty) the

@@ -607,7 +607,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     {
       if (const int nonFinite = mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene))
         vtkWarningMacro(<< "the volume property holds " << nonFinite
-                        << " value(s) that are not finite (NaN opacity, colour, unit distance or component "
+                        << " value(s) that are not finite (NaN in a transfer function or a component "
                            "weight); they were read as 0");
       if (in.Layout.labels >= 0)
       {

@@ -154,10 +154,14 @@ struct Classifier {
     float k[kCoefficientFloats];
     if (additive) {
       // The mixture: each material's coefficients weighted by its share of
-      // sigma_t (of the sum before the clamp: the shares add up to 1).
+      // sigma_t (of the sum before the clamp, so that the shares add up to
+      // 1; summed again only where the clamp applied).
       for (int i = 0; i < kCoefficientFloats; ++i) k[i] = 0.f;
-      float total = 0.f;
-      for (int m = 0; m < materialCount; ++m) total += Density(m, c.proxies);
+      float total = c.sigma_t;
+      if (!(total < maxExtinction)) {
+        total = 0.f;
+        for (int m = 0; m < materialCount; ++m) total += Density(m, c.proxies);
+      }
       for (int m = 0; m < materialCount; ++m) {
         const float d = Density(m, c.proxies);
         if (!(d > 0.f)) continue;
