@@ -14,6 +14,7 @@ packages=(
   python3-venv             # .venv: Mitsuba 3, numpy, matplotlib (accuracy checks and charts)
   clang-14 libclang-rt-14-dev   # libFuzzer + sanitizer runtimes (Testing/Fuzz)
   invesalius-examples   # the default input: Cranium.inv3
+  debootstrap           # the ParaView root of the plugin's build and tests (scripts/paraview-root.sh)
 )
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi

@@ -523,7 +523,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         if (now.Exact == in.PassStamp.Exact && SameView(now.View, in.PassStamp.View))
         {
           if (in.Shown)
-            this->Draw(ren, vol, *in.Shown);
+            this->DrawFilm(ren, vol, *in.Shown);
           return;
         }
       }
@@ -683,7 +683,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     if (interactive)
     {
       this->RenderPreview(ren, width, height, 1.0 / window->GetDesiredUpdateRate());
-      this->Draw(ren, vol, *in.Preview);
+      this->DrawFilm(ren, vol, *in.Preview);
       return;
     }
     in.Preview.reset();
@@ -723,7 +723,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         p->Done = true;
       });
       in.InFlight = std::move(pass);
-      this->Draw(ren, vol, *in.Shown);
+      this->DrawFilm(ren, vol, *in.Shown);
       return;
     }
     if (samples > 0)
@@ -737,7 +737,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  this->Draw(ren, vol, *in.Film);
+  this->DrawFilm(ren, vol, *in.Film);
 }
 
 // The proxies of the input (its components as the property uses them), the
@@ -1005,7 +1005,7 @@ void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, in
   ++in.InteractiveRenders;
 }
 
-void vtkMultiMaterialVolumeMapper::Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
+void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
 {
   // The image: tone-mapped, premultiplied RGBA, bottom row first for OpenGL.
   const int width = film.Width(), height = film.Height();

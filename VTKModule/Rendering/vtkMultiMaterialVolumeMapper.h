@@ -346,10 +346,18 @@ protected:
   vtkTypeBool InteractiveAdjustResolution = 1;
   double EnvironmentIntensity = 1.0;
 
+  /**
+   * Draws a film into the viewport (tone-mapped, premultiplied). Render()
+   * draws through this hook: the accumulated film of a still render, or
+   * the preview or last finished pass of the interactive and asynchronous
+   * modes. Sample-parallel rendering (the ParaView plugin under MPI)
+   * overrides it to combine the films of all processes first.
+   */
+  virtual void DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
+
 private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
   void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
-  void Draw(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();

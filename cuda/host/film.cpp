@@ -1,6 +1,9 @@
 #include "film.h"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace mmrtm {
 
@@ -40,6 +43,37 @@ NoiseEstimate Film::Noise() const {
   e.rmsStandardError = std::sqrt(sumVar / n);
   e.relative = e.meanLuminance > 0 ? e.rmsStandardError / e.meanLuminance : 0;
   return e;
+}
+
+std::vector<double> Film::Moments() const {
+  const size_t pixels = (size_t)width_ * height_;
+  std::vector<double> out(pixels * kMomentsPerPixel);
+  const double n = samples_;
+  for (size_t i = 0; i < pixels; ++i) {
+    double* o = &out[i * kMomentsPerPixel];
+    for (int c = 0; c < 4; ++c) o[c] = n * mean_[4 * i + c];
+    for (int c = 0; c < 3; ++c) o[4 + c] = m2_[3 * i + c] + n * (double)mean_[4 * i + c] * mean_[4 * i + c];
+  }
+  return out;
+}
+
+Film Film::FromMoments(int width, int height, uint32_t samples, const std::vector<double>& moments) {
+  Film film(width, height);
+  const size_t pixels = (size_t)width * height;
+  if (moments.size() != pixels * kMomentsPerPixel)
+    throw std::invalid_argument("Film::FromMoments: " + std::to_string(moments.size()) + " moments for " +
+                                std::to_string(width) + " x " + std::to_string(height) + " pixels");
+  film.samples_ = samples;
+  if (samples == 0) return film;
+  const double n = samples;
+  for (size_t i = 0; i < pixels; ++i) {
+    const double* m = &moments[i * kMomentsPerPixel];
+    for (int c = 0; c < 4; ++c) film.mean_[4 * i + c] = (float)(m[c] / n);
+    // M2 = sum over films of (M2 + n mean^2) - n mean^2 of the whole; never
+    // below 0 (rounding where all samples agree).
+    for (int c = 0; c < 3; ++c) film.m2_[3 * i + c] = (float)std::max(0.0, m[4 + c] - m[c] * m[c] / n);
+  }
+  return film;
 }
 
 RGBImage Film::Linear() const {

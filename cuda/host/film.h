@@ -48,6 +48,18 @@ class Film {
   // 8-bit sRGB, row 0 at the top; 4 channels adds alpha (premultiplied colour).
   std::vector<uint8_t> ToneMapped(float exposure, ToneMapper op, int channels = 3) const;
 
+  // Sample-parallel rendering: films of independent sample streams of one
+  // image (other seeds, other processes) combine into one film as if all
+  // their samples had been added to it, by summing their moments. Per
+  // pixel, kMomentsPerPixel doubles: n mean (RGBA) and M2 + n mean^2 (RGB),
+  // with n the film's samples. Sums in double: exact enough for the
+  // variance of thousands of samples.
+  static constexpr int kMomentsPerPixel = 7;
+  std::vector<double> Moments() const;
+  // The film whose samples are `samples` in all, from the element-wise sum
+  // of the Moments() of films of this size (samples = the sum of theirs).
+  static Film FromMoments(int width, int height, uint32_t samples, const std::vector<double>& moments);
+
  private:
   int width_, height_;
   uint32_t samples_ = 0;

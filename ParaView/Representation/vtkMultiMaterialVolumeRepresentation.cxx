@@ -1,0 +1,335 @@
+#include "vtkMultiMaterialVolumeRepresentation.h"
+
+#include "vtkColorTransferFunction.h"
+#include "vtkCommand.h"
+#include "vtkCommunicator.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
+#include "vtkObjectFactory.h"
+#include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
+#include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkVolumeProperty.h"
+
+#include "vtkSampleParallelVolumeMapper.h"
+
+#include <set>
+
+vtkStandardNewMacro(vtkMultiMaterialVolumeRepresentation);
+
+vtkMultiMaterialVolumeRepresentation::vtkMultiMaterialVolumeRepresentation()
+{
+  // The superclass made a vtkMultiBlockVolumeMapper; the path tracer takes
+  // its place (the superclass's code only forwards the array selection and
+  // the scalar mode to it).
+  this->VolumeMapper = vtkSmartPointer<vtkSampleParallelVolumeMapper>::New();
+  // Defaults for a first image without a GUI (pvbatch): one still render
+  // gives 64 samples a pixel; a render of the unchanged view only redraws.
+  this->SetSamplesPerRender(64);
+  this->SetMaximumSamples(64);
+}
+
+vtkMultiMaterialVolumeRepresentation::~vtkMultiMaterialVolumeRepresentation()
+{
+  if (this->ObservedRenderer)
+    this->ObservedRenderer->RemoveObserver(this->StartRenderObserver);
+}
+
+vtkSampleParallelVolumeMapper* vtkMultiMaterialVolumeRepresentation::Mapper()
+{
+  return static_cast<vtkSampleParallelVolumeMapper*>(this->VolumeMapper.Get());
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetSamplesPerRender(int samples)
+{
+  this->Mapper()->SetTotalSamplesPerRender(samples);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetMaximumSamples(int samples)
+{
+  this->Mapper()->SetTotalMaximumSamples(samples);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetNoiseTarget(double target)
+{
+  this->Mapper()->SetTotalNoiseTarget(target);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetMaximumBounces(int bounces)
+{
+  this->Mapper()->SetMaximumBounces(bounces);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetShadowExtinctionScale(double scale)
+{
+  this->Mapper()->SetShadowExtinctionScale(scale);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetSeed(int seed)
+{
+  this->Mapper()->SetBaseSeed(seed);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetAccelerator(int accelerator)
+{
+  this->Mapper()->SetAccelerator(accelerator);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetBackend(int backend)
+{
+  this->Mapper()->SetBackend(backend);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetNumberOfThreads(int threads)
+{
+  this->Mapper()->SetThreadsPerProcess(threads);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetExposure(double exposure)
+{
+  this->Mapper()->SetExposure(exposure);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetLinearImageFile(const char* path)
+{
+  this->Mapper()->SetLinearImageFile(path);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetPreset(const char* name)
+{
+  const std::string value = name ? name : "";
+  if (value == this->Preset)
+    return;
+  this->Preset = value;
+  this->UpdateMaterialSource();
+  this->Modified();
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetSceneFile(const char* path)
+{
+  const std::string value = path ? path : "";
+  if (value == this->SceneFile)
+    return;
+  this->SceneFile = value;
+  this->UpdateMaterialSource();
+  this->Modified();
+}
+
+// A scene file, else a preset, else ParaView's transfer functions (the
+// mapper's translation of the volume property).
+void vtkMultiMaterialVolumeRepresentation::UpdateMaterialSource()
+{
+  bool ok = true;
+  if (!this->SceneFile.empty())
+    ok = this->Materials->SetSceneFile(this->SceneFile.c_str());
+  else if (!this->Preset.empty())
+    ok = this->Materials->SetPreset(this->Preset.c_str());
+  if (!ok)
+  {
+    // vtkMultiMaterialProperty said why; keep ParaView's functions.
+    vtkErrorMacro("could not use " << (this->SceneFile.empty() ? "the preset \"" + this->Preset + "\""
+                                                              : "the scene file " + this->SceneFile)
+                                   << ": rendering ParaView's transfer functions");
+  }
+  const bool useMaterials = ok && (!this->SceneFile.empty() || !this->Preset.empty());
+  this->Mapper()->SetMultiMaterialProperty(useMaterials ? this->Materials.Get() : nullptr);
+}
+
+void vtkMultiMaterialVolumeRepresentation::SetLabelMapArray(const char* name)
+{
+  const std::string value = name ? name : "";
+  if (value == this->LabelMapArray)
+    return;
+  this->LabelMapArray = value;
+  this->MarkModified();  // RequestData makes the mask
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetAccumulatedSamples()
+{
+  return this->Mapper()->GetCombinedSamples();
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfCombinedRenders()
+{
+  return this->Mapper()->GetNumberOfCombinedRenders();
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfLocalRenders()
+{
+  return this->Mapper()->GetNumberOfLocalRenders();
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfRefits()
+{
+  return this->Mapper()->GetNumberOfRefits();
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfRestarts()
+{
+  return this->Mapper()->GetNumberOfRestarts();
+}
+
+// Every process asks for the whole volume: each renders samples of the
+// whole image (ParaView would otherwise give each its piece of the data).
+int vtkMultiMaterialVolumeRepresentation::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!this->Superclass::RequestUpdateExtent(request, inputVector, outputVector))
+    return 0;
+  for (int port = 0; port < this->GetNumberOfInputPorts(); ++port)
+  {
+    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
+    {
+      vtkInformation* info = inputVector[port]->GetInformationObject(i);
+      info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+      info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+      info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+      if (info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+        info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+          info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+    }
+  }
+  return 1;
+}
+
+int vtkMultiMaterialVolumeRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  const int result = this->Superclass::RequestData(request, inputVector, outputVector);
+  this->UpdateLabelMap();
+  return result;
+}
+
+// The label map: the named point array as the mapper's mask, and a material
+// for each label (a colour of the palette, the representation's opacity).
+void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
+{
+  vtkImageData* image = vtkImageData::SafeDownCast(this->Cache);
+  vtkDataArray* labels = image && !this->LabelMapArray.empty()
+    ? image->GetPointData()->GetArray(this->LabelMapArray.c_str())
+    : nullptr;
+  if (!labels)
+  {
+    if (image && !this->LabelMapArray.empty())
+      vtkWarningMacro("the input has no point array \"" << this->LabelMapArray << "\": no label map");
+    this->Mapper()->SetMaskInput(nullptr);
+    return;
+  }
+  if (labels->GetNumberOfComponents() != 1)
+  {
+    vtkWarningMacro("the label map array \"" << this->LabelMapArray << "\" has "
+                                             << labels->GetNumberOfComponents()
+                                             << " components, not 1: no label map");
+    this->Mapper()->SetMaskInput(nullptr);
+    return;
+  }
+  vtkNew<vtkImageData> mask;
+  mask->CopyStructure(image);
+  mask->GetPointData()->SetScalars(labels);
+  this->Mapper()->SetMaskInput(mask);
+  this->Mapper()->SetMaskTypeToLabelMap();
+
+  // Up to 64 labels (0 is the background): more is not a label map.
+  std::set<int> found;
+  for (vtkIdType i = 0, n = labels->GetNumberOfTuples(); i < n && found.size() <= 64; ++i)
+  {
+    const int label = static_cast<int>(labels->GetTuple1(i));
+    if (label != 0)
+      found.insert(label);
+  }
+  if (found.size() > 64)
+  {
+    vtkWarningMacro("the label map array \"" << this->LabelMapArray
+                                             << "\" has more than 64 labels: only the first 64 are materials");
+  }
+  vtkVolumeProperty* property = this->Property;
+  if (!property)
+    return;
+  // A qualitative palette (ColorBrewer's Set1 and Dark2).
+  static const double palette[][3] = { { 0.89, 0.10, 0.11 }, { 0.22, 0.49, 0.72 }, { 0.30, 0.69, 0.29 },
+    { 0.60, 0.31, 0.64 }, { 1.00, 0.50, 0.00 }, { 1.00, 1.00, 0.20 }, { 0.65, 0.34, 0.16 },
+    { 0.97, 0.51, 0.75 }, { 0.11, 0.62, 0.47 }, { 0.85, 0.37, 0.01 }, { 0.46, 0.44, 0.70 },
+    { 0.40, 0.65, 0.12 } };
+  const int colours = static_cast<int>(sizeof(palette) / sizeof(palette[0]));
+  int index = 0;
+  for (int label : found)
+  {
+    vtkNew<vtkColorTransferFunction> colour;
+    const double* c = palette[index++ % colours];
+    colour->AddRGBPoint(0.0, c[0], c[1], c[2]);
+    property->SetLabelColor(label, colour);
+    property->SetLabelScalarOpacity(label, property->GetScalarOpacity(0));
+  }
+}
+
+bool vtkMultiMaterialVolumeRepresentation::AddToView(vtkView* view)
+{
+  if (!this->Superclass::AddToView(view))
+    return false;
+  if (vtkPVRenderView* rview = vtkPVRenderView::SafeDownCast(view))
+  {
+    this->ObservedView = view;
+    this->ObservedRenderer = rview->GetRenderer();
+    this->StartRenderObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::StartEvent, this, &vtkMultiMaterialVolumeRepresentation::OnStartRender);
+  }
+  return true;
+}
+
+bool vtkMultiMaterialVolumeRepresentation::RemoveFromView(vtkView* view)
+{
+  if (view == this->ObservedView)
+  {
+    if (this->ObservedRenderer)
+      this->ObservedRenderer->RemoveObserver(this->StartRenderObserver);
+    this->ObservedRenderer = nullptr;
+    this->ObservedView = nullptr;
+  }
+  return this->Superclass::RemoveFromView(view);
+}
+
+// The processes agree whether all of them render this representation now.
+// Every process that renders the view gets here (a renderer's StartEvent),
+// hidden or not; with distributed rendering off, only one process renders
+// and nothing is combined.
+void vtkMultiMaterialVolumeRepresentation::OnStartRender()
+{
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  vtkPVRenderView* view = vtkPVRenderView::SafeDownCast(this->ObservedView.GetPointer());
+  if (!controller || controller->GetNumberOfProcesses() < 2 || !view ||
+    !view->GetUseDistributedRenderingForRender())
+  {
+    this->Mapper()->SetCombineThisRender(false);
+    return;
+  }
+  vtkPVLODVolume* actor = this->GetRenderedProp();
+  // This process renders the mapper when the actor is visible and draws
+  // its full level of detail (not the outline).
+  const int mine = this->GetVisibility() && actor && actor->GetVisibility() && !actor->GetEnableLOD() &&
+      this->Cache && this->VolumeMapper->GetNumberOfInputConnections(0) > 0
+    ? 1
+    : 0;
+  int all = 0;
+  controller->AllReduce(&mine, &all, 1, vtkCommunicator::MIN_OP);
+  this->Mapper()->SetCombineThisRender(all == 1);
+  if (mine && !all)
+  {
+    vtkWarningMacro("some process does not render this representation (hidden there, its outline "
+                    "drawn instead, or no data): this render shows this process's samples only");
+  }
+}
+
+void vtkMultiMaterialVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Preset: \"" << this->Preset << "\"\n";
+  os << indent << "SceneFile: \"" << this->SceneFile << "\"\n";
+  os << indent << "LabelMapArray: \"" << this->LabelMapArray << "\"\n";
+}

@@ -1,0 +1,80 @@
+"""The plugin in pvbatch (serially): it loads, the representation type is
+offered for image data, the head CT renders non-blank with the silhouette
+of ParaView's own "Volume" representation of the same transfer functions,
+a transfer-function edit from Python refits and restarts the accumulation,
+and a camera change restarts it without a refit.
+
+    pvbatch test_plugin.py OUTDIR     (in the ParaView root, under X)
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import numpy as np  # noqa: E402
+import pv_scene  # noqa: E402
+from paraview import simple as pv  # noqa: E402
+
+out = sys.argv[1] if len(sys.argv) > 1 else "."
+os.makedirs(out, exist_ok=True)
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+pv_scene.load_plugin()
+s = pv_scene.Scene(size=(256, 256))
+offered = list(s.display.Representation.Available)
+check(pv_scene.PATH_TRACED in offered, "the representation type is offered: %s" % offered)
+
+s.use("Volume")
+volume = s.capture(os.path.join(out, "paraview-volume.png"))
+s.use(pv_scene.PATH_TRACED)
+traced = s.capture(os.path.join(out, "path-traced.png"))
+
+# Silhouettes: pixels brighter than a tenth of the image's brightest
+# (luminance), against a black background.
+def silhouette(image):
+    lum = image.astype(np.float64) @ np.array([0.2126, 0.7152, 0.0722])
+    return lum > 0.1 * lum.max()
+
+
+a, b = silhouette(traced), silhouette(volume)
+iou = float((a & b).sum()) / max(1, float((a | b).sum()))
+check(traced.max() > 100 and a.mean() > 0.05,
+      "the path-traced head CT is not blank (max %d, %.0f %% of the pixels)" % (traced.max(), 100 * a.mean()))
+check(traced.mean() < 200, "nor blown out (mean %.1f)" % traced.mean())
+check(iou > 0.85, "its silhouette matches ParaView's Volume representation: IoU %.3f" % iou)
+samples = s.counter("AccumulatedSamples")
+check(samples == 64, "one still render gives the default 64 samples a pixel (%d)" % samples)
+
+refits, restarts = s.counter("NumberOfRefits"), s.counter("NumberOfRestarts")
+s.set_bone_ramp(low=400.0, high=900.0)  # a transfer-function edit
+pv.Render(s.view)
+# pvbatch's Render() renders the view twice, and ParaView touches the volume
+# property between them: one edit may count as two refits, never none.
+check(refits < s.counter("NumberOfRefits") <= refits + 2 and s.counter("NumberOfRestarts") > restarts,
+      "a transfer-function edit refits and restarts (refits %d -> %d, restarts %d -> %d)"
+      % (refits, s.counter("NumberOfRefits"), restarts, s.counter("NumberOfRestarts")))
+edited = s.capture(os.path.join(out, "path-traced-edited.png"))
+check(silhouette(edited).sum() < a.sum(), "the higher bone threshold shows less (%d < %d pixels)"
+      % (silhouette(edited).sum(), a.sum()))
+
+refits, restarts = s.counter("NumberOfRefits"), s.counter("NumberOfRestarts")
+s.view.GetActiveCamera().Azimuth(30)
+pv.Render(s.view)
+check(s.counter("NumberOfRestarts") == restarts + 1 and s.counter("NumberOfRefits") == refits,
+      "a camera change restarts without a refit (restarts %d -> %d, refits %d -> %d)"
+      % (restarts, s.counter("NumberOfRestarts"), refits, s.counter("NumberOfRefits")))
+
+s.display.Preset = "ct-bone"
+pv.Render(s.view)
+preset = s.capture(os.path.join(out, "path-traced-preset.png"))
+check(silhouette(preset).mean() > 0.05, "the ct-bone preset renders (%.0f %% of the pixels)"
+      % (100 * silhouette(preset).mean()))
+
+if failures:
+    sys.exit("%d check(s) failed" % len(failures))
