@@ -76,5 +76,30 @@ preset = s.capture(os.path.join(out, "path-traced-preset.png"))
 check(silhouette(preset).mean() > 0.05, "the ct-bone preset renders (%.0f %% of the pixels)"
       % (100 * silhouette(preset).mean()))
 
+# A label map: a second point array (here made from the CT itself: 1 where
+# it is above 300 HU) named as LabelMapArray. Label 1 becomes a material of
+# its own, coloured from the palette (its first colour is red).
+s.display.Preset = ""
+calc = pv.Calculator(Input=s.reader, ResultArrayName="labels", Function="%s > 300" % s.array)
+labelled = pv.Show(calc, s.view)
+pv.Hide(s.reader, s.view)
+pv.ColorBy(labelled, ("POINTS", s.array))
+labelled.SetRepresentationType(pv_scene.PATH_TRACED)
+pv.Render(s.view)
+plain = s.capture(os.path.join(out, "path-traced-calculator.png")).astype(np.float64)
+labelled.LabelMapArray = "labels"
+pv.Render(s.view)
+with_labels = s.capture(os.path.join(out, "path-traced-labels.png")).astype(np.float64)
+
+
+def redness(image):
+    lit = silhouette(image)
+    return float(image[lit, 0].mean() / max(1e-6, image[lit, 1].mean()))
+
+
+check(redness(with_labels) > 1.5 * redness(plain),
+      "a label-map array colours its label from the palette (red/green %.2f, without %.2f)"
+      % (redness(with_labels), redness(plain)))
+
 if failures:
     sys.exit("%d check(s) failed" % len(failures))
