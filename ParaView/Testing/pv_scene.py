@@ -6,7 +6,6 @@ import os
 import sys
 
 from paraview import simple as pv
-from paraview import servermanager as sm
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE_DIR = os.path.dirname(os.path.dirname(HERE))
