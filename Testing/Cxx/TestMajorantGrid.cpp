@@ -212,6 +212,30 @@ TEST(Refit, AfterADataChangeInARegionEqualsAFullRebuild) {
     ASSERT_EQ(updated.majorants.grid.majorants[i], rebuilt.Grid()->View().majorants[i]) << "node " << i;
 }
 
+TEST(Refit, ARegionEditedBeyondTheValueRangeStillBoundsTheExtinction) {
+  // The summaries bin integer voxels through a table of the values the
+  // last full build saw; an edit to values beyond them (here above the CT's
+  // maximum, 3926) must still be binned, into the top bin.
+  HostVolume ct = LoadVolume(Data("ct_head_headsq.nrrd"));
+  Scene scene = SceneWith({ct}, {CCTF({500.f, 4500.f, 5000.f}, {0.f, 0.f, 1.f})}, 2.f, MajorantKind::Octree);
+  scene.Build();
+  const std::array<int, 3> lo{20, 30, 40}, hi{27, 33, 52};
+  int16_t* voxels = reinterpret_cast<int16_t*>(scene.proxies[0].voxels.data());
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x) voxels[x + 64 * (y + 64 * z)] = 5000;
+  scene.MarkRegionModified(lo, hi);
+  SceneView updated = scene.Build();
+  const MajorantGridView& g = scene.Grid()->View();
+  const int L = g.leafLevel, size = g.nodeSize[L];
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x) {
+        const int64_t leaf = x / size + (int64_t)g.res[L][0] * (y / size + (int64_t)g.res[L][1] * (z / size));
+        ASSERT_GE(updated.majorants.grid.majorants[g.offset[L] + leaf], 2.f) << "voxel " << x << " " << y << " " << z;
+      }
+}
+
 Film RenderWith(Scene& scene, MajorantKind kind, uint64_t seed) {
   scene.render.accelerator.kind = kind;
   scene.render.integrator.seed = seed;

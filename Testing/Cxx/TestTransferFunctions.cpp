@@ -1,6 +1,9 @@
 // The five TF types and the merge rules, against hand-computed values.
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <random>
+
 #include "TestSceneHelpers.h"
 
 namespace mmrtm {
@@ -56,6 +59,39 @@ TEST(TransferFunction, CCTFInterpolatesLinearlyAndClamps) {
   EXPECT_FLOAT_EQ(Eval1(tf, 200), 1.f);
   EXPECT_FLOAT_EQ(Eval1(tf, 300), 0.75f);
   EXPECT_FLOAT_EQ(Eval1(tf, 5000), 0.5f);  // clamped above
+}
+
+TEST(TransferFunction, EvenlySpacedCCTFFindsTheSegmentByArithmeticWithTheSameValues) {
+  // Tables sampled from VTK's functions have evenly spaced keys: Evaluate
+  // then finds the segment without a binary search. It must be the same
+  // segment, hence the same value to the bit, everywhere: at the keys,
+  // between them, outside, and for keys a little off even (float rounding
+  // of the sampled positions).
+  std::mt19937 rng(11);
+  for (float jitter : {0.f, 0.1f}) {
+    std::vector<float> keys(256), values(256);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    for (int i = 0; i < 256; ++i) {
+      keys[i] = -1024.f + 17.3f * ((float)i + jitter * u(rng));
+      values[i] = 0.5f + 0.5f * u(rng);
+    }
+    Scene s;
+    SceneView v = BuildWith(s, {Coefficient(TFType::CCTF, 0, 1, keys, values)});
+    const TransferFunctionView& fast = v.classifier.tfs[0];
+    ASSERT_GT(fast.uniformInverseStep, 0.f) << "evenly spaced keys (jitter " << jitter << ")";
+    TransferFunctionView search = fast;
+    search.uniformInverseStep = 0.f;  // the binary search
+    std::uniform_real_distribution<float> x(keys.front() - 100.f, keys.back() + 100.f);
+    for (int i = 0; i < 200000; ++i) {
+      const float at = i < 256 ? keys[i] : x(rng);
+      const float a = Eval1(fast, at), b = Eval1(search, at);
+      ASSERT_EQ(0, std::memcmp(&a, &b, sizeof a)) << "x = " << at;
+    }
+  }
+  // Unevenly spaced keys keep the binary search.
+  Scene s;
+  SceneView v = BuildWith(s, {Coefficient(TFType::CCTF, 0, 1, {0, 1, 2, 3, 4, 5, 6, 100}, {0, 1, 0, 1, 0, 1, 0, 1})});
+  EXPECT_EQ(v.classifier.tfs[0].uniformInverseStep, 0.f);
 }
 
 TEST(TransferFunction, CCTFThreeChannels) {

@@ -31,14 +31,29 @@ float HostVolume::Value(int64_t i) const {
   }
 }
 
-std::array<float, 2> HostVolume::ValueRange() const {
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (int64_t i = 0, n = VoxelCount(); i < n; ++i) {
-    float v = Value(i);
-    lo = v < lo ? v : lo;
-    hi = v > hi ? v : hi;
+namespace {
+// Minimum and maximum in the voxels' own type: a loop the compiler
+// vectorises (Value(i)'s switch per voxel does not), run once per load.
+template <typename T>
+std::array<float, 2> TypedRange(const T* v, int64_t n) {
+  if (n == 0) return {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
+  T lo = v[0], hi = v[0];
+  for (int64_t i = 1; i < n; ++i) {
+    lo = v[i] < lo ? v[i] : lo;
+    hi = v[i] > hi ? v[i] : hi;
   }
-  return {lo, hi};
+  return {(float)lo, (float)hi};
+}
+}  // namespace
+
+std::array<float, 2> HostVolume::ValueRange() const {
+  const int64_t n = VoxelCount();
+  switch (type) {
+    case VoxelType::UInt8: return TypedRange(voxels.data(), n);
+    case VoxelType::Int16: return TypedRange(reinterpret_cast<const int16_t*>(voxels.data()), n);
+    case VoxelType::UInt16: return TypedRange(reinterpret_cast<const uint16_t*>(voxels.data()), n);
+    default: return TypedRange(reinterpret_cast<const float*>(voxels.data()), n);
+  }
 }
 
 std::array<Vec3, 2> HostVolume::WorldBounds() const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <type_traits>
 
 #include "parallel_for.h"
 
@@ -29,14 +30,26 @@ inline void SetBinRange(uint64_t* words, int b0, int b1) {
 // the bin of the min and max of an edge are the min and max of its bins).
 template <typename T>
 void SummarizeBlock(const T* data, const std::array<int, 3>& dims, const int lo[3], const int hi[3],
-                    const MajorantGrid::BinMap& bins, bool edges, uint64_t* words, std::vector<int16_t>& scratch) {
+                    const MajorantGrid::BinMap& bins, const std::vector<int16_t>& binTable, int binTableMin,
+                    bool edges, uint64_t* words, std::vector<int16_t>& scratch) {
   const int nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1, nz = hi[2] - lo[2] + 1;
   scratch.resize((size_t)nx * ny * nz);
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y) {
       const T* row = data + lo[0] + (int64_t)dims[0] * ((y + lo[1]) + (int64_t)dims[1] * (z + lo[2]));
       int16_t* out = &scratch[(size_t)nx * (y + (size_t)ny * z)];
-      for (int x = 0; x < nx; ++x) out[x] = (int16_t)bins.Bin((float)row[x]);
+      for (int x = 0; x < nx; ++x) {
+        if constexpr (std::is_integral_v<T>) {
+          // The table covers the values of the last full build; an edited
+          // region may hold others.
+          const int64_t t = (int64_t)row[x] - binTableMin;
+          if (t >= 0 && t < (int64_t)binTable.size()) {
+            out[x] = binTable[(size_t)t];
+            continue;
+          }
+        }
+        out[x] = (int16_t)bins.Bin((float)row[x]);
+      }
     }
   auto at = [&](int x, int y, int z) { return scratch[x + (size_t)nx * (y + (size_t)ny * z)]; };
   for (int z = 0; z < nz; ++z)
@@ -142,6 +155,14 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
     b.width = b.discrete ? 1.f : std::max((range[1] - range[0]) / kSummaryBins, 1e-30f);
     if (!(range[1] > range[0])) b.width = 1.f;
     b.slack = v.interpolation == Interpolation::Trilinear ? kPositionTolerance * (range[1] - range[0]) : 0.f;
+    binTables_[k].clear();
+    if (v.type != VoxelType::Float32 && range[1] >= range[0]) {
+      // At most 65,536 entries (16-bit voxels), each the bin Bin() gives.
+      binTableMin_[k] = (int)range[0];
+      binTables_[k].resize((size_t)((int)range[1] - (int)range[0] + 1));
+      for (size_t i = 0; i < binTables_[k].size(); ++i)
+        binTables_[k][i] = (int16_t)b.Bin((float)(binTableMin_[k] + (int)i));
+    }
     if (options_.summary == SummaryMode::VoxelValues) continue;
     leafIndexToProxy_[k] = AffineCompose(v.View().worldToIndex, v0.indexToWorld);
     sameGrid_[k] = AffineIsIdentity(leafIndexToProxy_[k], 1e-5f) && v.dims == v0.dims;
@@ -225,20 +246,22 @@ void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx,
     }
     const bool edges = v.interpolation == Interpolation::Trilinear && options_.summary == SummaryMode::CellRanges;
     uint64_t* words = &summaries_[k][(size_t)leafIndex * kSummaryWords];
+    const std::vector<int16_t>& table = binTables_[k];
+    const int tableMin = binTableMin_[k];
     switch (v.type) {
       case VoxelType::UInt8:
-        SummarizeBlock(v.voxels.data(), v.dims, lo, hi, bins_[k], edges, words, scratch);
+        SummarizeBlock(v.voxels.data(), v.dims, lo, hi, bins_[k], table, tableMin, edges, words, scratch);
         break;
       case VoxelType::Int16:
-        SummarizeBlock(reinterpret_cast<const int16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], edges, words,
+        SummarizeBlock(reinterpret_cast<const int16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin, edges, words,
                        scratch);
         break;
       case VoxelType::UInt16:
-        SummarizeBlock(reinterpret_cast<const uint16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], edges, words,
+        SummarizeBlock(reinterpret_cast<const uint16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin, edges, words,
                        scratch);
         break;
       case VoxelType::Float32:
-        SummarizeBlock(reinterpret_cast<const float*>(v.voxels.data()), v.dims, lo, hi, bins_[k], edges, words,
+        SummarizeBlock(reinterpret_cast<const float*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin, edges, words,
                        scratch);
         break;
     }

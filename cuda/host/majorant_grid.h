@@ -112,6 +112,10 @@ class MajorantGrid {
   std::array<Affine3, kMaxProxies> leafIndexToProxy_;  // proxy 0 index -> proxy k index
   std::array<bool, kMaxProxies> sameGrid_{};           // leafIndexToProxy_ is the identity
   std::array<BinMap, kMaxProxies> bins_;
+  // Integer voxels: BinMap::Bin of every value from binTableMin_ up, so
+  // that the summaries look bins up instead of dividing (empty for float).
+  std::array<std::vector<int16_t>, kMaxProxies> binTables_;
+  std::array<int, kMaxProxies> binTableMin_{};
   std::array<std::vector<uint64_t>, kMaxProxies> summaries_;
   std::vector<float> majorants_;
   double buildSeconds_ = 0, refitSeconds_ = 0;

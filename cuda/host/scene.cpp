@@ -19,6 +19,19 @@ std::string Str(float v) {
   return s.str();
 }
 
+// 1 / the spacing of CCTF keys that are evenly spaced to within a quarter
+// of it (TransferFunctionView::uniformInverseStep: the segment estimate is
+// then off by at most one), else 0. Short curves keep the binary search.
+float UniformInverseStep(const std::vector<float>& keys) {
+  const size_t n = keys.size();
+  if (n < 8) return 0.f;
+  const double step = ((double)keys.back() - keys.front()) / (double)(n - 1);
+  if (!(step > 0.0) || !std::isfinite(step)) return 0.f;
+  for (size_t i = 0; i < n; ++i)
+    if (!(std::abs((double)keys[i] - (keys.front() + step * (double)i)) <= 0.25 * step)) return 0.f;
+  return (float)(1.0 / step);
+}
+
 }  // namespace
 
 int Scene::ProxyIndex(const std::string& name) const {
@@ -240,6 +253,7 @@ SceneView Scene::Build() {
     v.denseIndex = o.denseCount ? intPool_.data() + o.dense : nullptr;
     v.denseMin = o.denseMin;
     v.denseCount = o.denseCount;
+    v.uniformInverseStep = tf.type == TFType::CCTF ? UniformInverseStep(tf.keys) : 0.f;
     tfViews_.push_back(v);
   }
 

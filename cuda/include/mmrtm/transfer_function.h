@@ -42,6 +42,11 @@ struct TransferFunctionView {
   // keys span a small integer range (labels); otherwise a binary search.
   const int* denseIndex = nullptr;
   int denseMin = 0, denseCount = 0;
+  // CCTF with evenly spaced keys (tables sampled from VTK's functions): 1 /
+  // the spacing, so that Evaluate finds the segment by arithmetic and one
+  // correction instead of a binary search (the same segment, hence the same
+  // value to the bit); 0 when the keys are not evenly spaced.
+  float uniformInverseStep = 0.f;
 
   // Entry index for x, or -1. For a CCTF: the segment start (see Evaluate).
   MMRTM_CPU_GPU int FindEntry(float x) const {
@@ -72,10 +77,20 @@ struct TransferFunctionView {
     if (type == TFType::CCTF) {
       if (x <= keys[0] || count == 1) return Copy(0, out);
       if (x >= keys[count - 1]) return Copy(count - 1, out);
-      int lo = 0, hi = count - 1;  // keys[lo] < x < keys[hi]
-      while (hi - lo > 1) {
-        int mid = (lo + hi) >> 1;
-        if (keys[mid] <= x) lo = mid; else hi = mid;
+      int lo = 0, hi = count - 1;  // keys[lo] <= x < keys[hi]
+      const float f = (x - keys[0]) * uniformInverseStep;
+      if (uniformInverseStep > 0.f && f >= 0.f && f < (float)(count - 1)) {
+        // Evenly spaced keys (to within a quarter step, Scene::Build checks):
+        // the estimate is the segment or one of its neighbours.
+        lo = (int)f;
+        if (keys[lo] > x) --lo;
+        else if (keys[lo + 1] <= x) ++lo;
+        hi = lo + 1;
+      } else {
+        while (hi - lo > 1) {
+          int mid = (lo + hi) >> 1;
+          if (keys[mid] <= x) lo = mid; else hi = mid;
+        }
       }
       float t = (x - keys[lo]) / (keys[hi] - keys[lo]);
       for (int c = 0; c < channels; ++c)
