@@ -15,15 +15,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Sets bins [b0, b1] of a kSummaryWords-word mask.
-inline void SetBinRange(uint64_t* words, int b0, int b1) {
-  for (int w = b0 >> 6; w <= (b1 >> 6); ++w) {
-    const int lo = std::max(b0 - (w << 6), 0), hi = std::min(b1 - (w << 6), 63);
-    const uint64_t upper = hi == 63 ? ~0ull : ((1ull << (hi + 1)) - 1);
-    words[w] |= upper & ~((1ull << lo) - 1);
-  }
-}
-
 // The bins of a voxel block [lo, hi] (inclusive) of one proxy: each voxel's
 // bin, and with `edges` every bin between the bins of neighbouring voxels
 // (the range a trilinear cell takes is the union of its edge intervals, and
@@ -51,23 +42,35 @@ void SummarizeBlock(const T* data, const std::array<int, 3>& dims, const int lo[
         out[x] = (int16_t)bins.Bin((float)row[x]);
       }
     }
-  auto at = [&](int x, int y, int z) { return scratch[x + (size_t)nx * (y + (size_t)ny * z)]; };
+  // Each voxel adds the interval [b0, b1] of its bin and its forward
+  // neighbours' (all contain its own bin, so their union is one interval).
+  // The union over the block is kept as a difference array and set as bits
+  // once at the end: two additions a voxel instead of a mask update.
+  int32_t delta[kSummaryBins + 1] = {};
+  int first = kSummaryBins, last = -1;  // the bins touched: the scan covers these only
+  const size_t sy = (size_t)nx, sz = (size_t)nx * ny;
   for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y)
+    for (int y = 0; y < ny; ++y) {
+      const int16_t* r = &scratch[sy * y + sz * z];
+      const bool nextY = edges && y + 1 < ny, nextZ = edges && z + 1 < nz;
       for (int x = 0; x < nx; ++x) {
-        const int b = at(x, y, z);
-        int b0 = b, b1 = b;
+        int b0 = r[x], b1 = b0;
         if (edges) {
-          if (x + 1 < nx) b0 = std::min(b0, (int)at(x + 1, y, z)), b1 = std::max(b1, (int)at(x + 1, y, z));
-          if (y + 1 < ny) b0 = std::min(b0, (int)at(x, y + 1, z)), b1 = std::max(b1, (int)at(x, y + 1, z));
-          if (z + 1 < nz) b0 = std::min(b0, (int)at(x, y, z + 1)), b1 = std::max(b1, (int)at(x, y, z + 1));
+          if (x + 1 < nx) b0 = std::min(b0, (int)r[x + 1]), b1 = std::max(b1, (int)r[x + 1]);
+          if (nextY) b0 = std::min(b0, (int)r[x + sy]), b1 = std::max(b1, (int)r[x + sy]);
+          if (nextZ) b0 = std::min(b0, (int)r[x + sz]), b1 = std::max(b1, (int)r[x + sz]);
         }
-        if (b0 == b1) {
-          words[b0 >> 6] |= 1ull << (b0 & 63);
-        } else {
-          SetBinRange(words, b0, b1);
-        }
+        ++delta[b0];
+        --delta[b1 + 1];
+        first = std::min(first, b0);
+        last = std::max(last, b1);
       }
+    }
+  int covered = 0;
+  for (int b = first; b <= last; ++b) {
+    covered += delta[b];
+    if (covered > 0) words[b >> 6] |= 1ull << (b & 63);
+  }
 }
 
 }  // namespace
