@@ -132,6 +132,7 @@ void vtkSampleParallelVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     this->Combine(nullptr);
   }
   ++this->CombinedRenders;
+  this->CombineThisRender = false;  // one render: the next is agreed on anew
 }
 
 void vtkSampleParallelVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)

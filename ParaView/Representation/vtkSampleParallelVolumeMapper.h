@@ -76,7 +76,7 @@ public:
   /**
    * Whether the next Render() combines the films of all processes: call it
    * with the same value on every process before a render (see the class
-   * documentation).
+   * documentation). It holds for one render.
    */
   void SetCombineThisRender(bool combine) { this->CombineThisRender = combine; }
 
