@@ -13,6 +13,7 @@
 
 #include "TestSceneHelpers.h"
 #include "cpu_renderer.h"
+#include "mmrtm/majorant_refit.h"
 #include "mmrtm/rng.h"
 #include "mmrtmVolumeLoader.h"
 
@@ -189,6 +190,29 @@ TEST(Refit, AfterATransferFunctionChangeEqualsAFullRebuild) {
   }
   EXPECT_GT(nonZero, 0);
   EXPECT_LT(nonZero, refitted.Grid()->NodeCount()) << "a narrow TF should leave empty nodes";
+}
+
+TEST(Refit, ByteTablesGiveTheSameLeafMajorantsAsTheBins) {
+  // The CPU refit takes each leaf's maximum through per-byte tables; the
+  // CUDA refit walks the set bins. Both must give every leaf the same value.
+  HostVolume ct = LoadVolume(Data("ct_head_headsq.nrrd"));
+  Scene scene = SceneWith({ct}, {CCTF({300.f, 700.f, 900.f, 1400.f, 2600.f}, {0.f, 0.9f, 0.1f, 1.f, 0.3f})}, 2.f,
+                          MajorantKind::Octree);
+  SceneView view = scene.Build();
+  const MajorantGrid& grid = *scene.Grid();
+  const MajorantGrid::RefitTables tables = grid.MakeRefitTables(view.classifier);
+  RefitInputs bins, bytes;
+  bins.summaries[0] = bytes.summaries[0] = grid.Summaries(0).data();
+  bins.binMax = bytes.binMax = tables.binMax.data();
+  bins.binMaterials = bytes.binMaterials = tables.binMaterials.data();
+  bytes.byteMax = tables.byteMax.data();
+  int nonZero = 0;
+  for (int64_t leaf = 0; leaf < grid.LeafCount(); ++leaf) {
+    const float a = LeafMajorant(view.classifier, bins, leaf), b = LeafMajorant(view.classifier, bytes, leaf);
+    ASSERT_EQ(a, b) << "leaf " << leaf;
+    nonZero += a > 0.f;
+  }
+  EXPECT_GT(nonZero, 100);
 }
 
 TEST(Refit, AfterADataChangeInARegionEqualsAFullRebuild) {

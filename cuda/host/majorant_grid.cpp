@@ -302,6 +302,7 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
   // can pick (material TFs) over the bin's value range.
   RefitTables t;
   t.binMax.assign((size_t)c.tfCount * kSummaryBins, 0.f);
+  t.byteMax.assign((size_t)c.tfCount * kSummaryBytes * 256, 0.f);
   t.binMaterials.assign((size_t)c.tfCount * kSummaryBins, 0);
   t.materialMasks = c.materialCount <= 64;
   for (int i = 0; i < c.tfCount; ++i) {
@@ -319,6 +320,13 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
         tf.MaxOverRange(lo, hi, v);
         t.binMax[(size_t)i * kSummaryBins + b] = v[0];
       }
+    }
+    // Each byte value's maximum: that of the value without its lowest bit,
+    // and that bit's bin.
+    for (int byte = 0; byte < kSummaryBytes && !IsMaterialTF(tf.type); ++byte) {
+      float* table = &t.byteMax[((size_t)i * kSummaryBytes + byte) * 256];
+      for (int v = 1; v < 256; ++v)
+        table[v] = std::max(table[v & (v - 1)], t.binMax[(size_t)i * kSummaryBins + byte * 8 + CountTrailingZeros64(v)]);
     }
   }
   return t;
@@ -338,6 +346,7 @@ void MajorantGrid::Refit(const Classifier& c) {
   in.binMax = tables.binMax.data();
   in.binMaterials = tables.binMaterials.data();
   in.materialMasks = tables.materialMasks;
+  in.byteMax = tables.byteMax.data();
   // Leaves (the same per-leaf function as the CUDA refit), then the levels above.
   const int64_t leafOffset = view_.offset[view_.leafLevel];
   ParallelFor(LeafCount(), options_.threads, [&](int64_t begin, int64_t end) {

@@ -77,6 +77,9 @@ class MajorantGrid {
     std::vector<float> binMax;
     std::vector<uint64_t> binMaterials;
     bool materialMasks = true;
+    // binMax by byte of a summary (RefitInputs::byteMax): the CPU refit's
+    // shortcut; the CUDA refit walks the bits.
+    std::vector<float> byteMax;
   };
   RefitTables MakeRefitTables(const Classifier& classifier) const;
   // Proxy k's leaf summaries: kSummaryWords words per leaf (empty with

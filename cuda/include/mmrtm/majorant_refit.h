@@ -38,7 +38,27 @@ struct RefitInputs {
   const float* binMax = nullptr;                // [tf * kSummaryBins + bin]: coefficient TFs
   const uint64_t* binMaterials = nullptr;       // [tf * kSummaryBins + bin]: material TFs, a mask of materials
   bool materialMasks = true;                    // false with more than 64 materials: every material counts
+  // Optional: [tf][byte of the summary][its value] the maximum of binMax
+  // over the byte's set bits, so that a leaf's maximum takes a lookup per
+  // non-zero byte instead of one per set bin. The same maximum either way.
+  const float* byteMax = nullptr;
 };
+
+constexpr int kSummaryBytes = kSummaryBins / 8;
+
+// The maximum of coefficient TF t's binMax over the set bins of a summary.
+MMRTM_CPU_GPU inline float MaxOverBins(const RefitInputs& in, int t, const uint64_t* words) {
+  float mx = 0.f;
+  if (in.byteMax) {
+    const float* table = in.byteMax + (size_t)t * kSummaryBytes * 256;
+    for (int w = 0; w < kSummaryWords; ++w)
+      for (uint64_t bits = words[w], byte = (uint64_t)w * 8; bits; bits >>= 8, ++byte)
+        if (bits & 0xff) mx = Max(mx, table[(byte << 8) | (bits & 0xff)]);
+    return mx;
+  }
+  ForEachBin(words, [&](int bin) { mx = Max(mx, in.binMax[t * kSummaryBins + bin]); });
+  return mx;
+}
 
 // The extinction bound of leaf `leaf`: over the materials that can occur in
 // it (the default, and whatever a material TF can pick from the leaf's
@@ -59,10 +79,7 @@ MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& 
     float d = mat.base[0];
     for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
       const int t = c.bindings[mat.bindingBegin + b].tf;
-      float mx = 0.f;
-      ForEachBin(in.summaries[c.tfs[t].proxy] + leaf * kSummaryWords,
-                 [&](int bin) { mx = Max(mx, in.binMax[t * kSummaryBins + bin]); });
-      d *= mx;
+      d *= MaxOverBins(in, t, in.summaries[c.tfs[t].proxy] + leaf * kSummaryWords);
     }
     majorant = c.additive ? majorant + d : Max(majorant, d);  // a mixture's extinctions add up
   }
