@@ -305,6 +305,11 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
   t.byteMax.assign((size_t)c.tfCount * kSummaryBytes * 256, 0.f);
   t.binMaterials.assign((size_t)c.tfCount * kSummaryBins, 0);
   t.materialMasks = c.materialCount <= 64;
+  // The refit reads the byte tables of density TFs only.
+  std::vector<char> density((size_t)c.tfCount, 0);
+  for (int m = 0; m < c.materialCount; ++m)
+    for (int b = 0; b < c.materials[m].densityBindingCount; ++b)
+      density[(size_t)c.bindings[c.materials[m].bindingBegin + b].tf] = 1;
   for (int i = 0; i < c.tfCount; ++i) {
     const TransferFunctionView& tf = c.tfs[i];
     for (int b = 0; b < kSummaryBins; ++b) {
@@ -322,8 +327,8 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
       }
     }
     // Each byte value's maximum: that of the value without its lowest bit,
-    // and that bit's bin.
-    for (int byte = 0; byte < kSummaryBytes && !IsMaterialTF(tf.type); ++byte) {
+    // and that bit's bin (32 x 255 entries a TF).
+    for (int byte = 0; byte < kSummaryBytes && density[(size_t)i] && !IsMaterialTF(tf.type); ++byte) {
       float* table = &t.byteMax[((size_t)i * kSummaryBytes + byte) * 256];
       for (int v = 1; v < 256; ++v)
         table[v] = std::max(table[v & (v - 1)], t.binMax[(size_t)i * kSummaryBins + byte * 8 + CountTrailingZeros64(v)]);
