@@ -22,6 +22,11 @@
 # block every change; those are printed, and fixed by pre-checks from the
 # longer runs here. The default, all, fails on any finding.
 #
+# MMRTM_FUZZ_KEEP_GOING=1 runs libFuzzer's fork mode (-fork=1 with crashes,
+# hangs and out-of-memory ignored): the run lasts its whole time and keeps
+# every finding's input, instead of stopping at the first. For the long runs
+# of the reader targets, where the third-party readers fail often.
+#
 # Usage: run_fuzzers.sh SOURCE_DIR BUILD_DIR SECONDS [TARGET...]
 # Writes BUILD/fuzz-summary.tsv: target, executions, corpus files, coverage
 # (edges), features, findings.
@@ -72,6 +77,7 @@ run_one() {
   local options=(-max_total_time="$seconds" -seed="${MMRTM_FUZZ_SEED:-1}" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024
                  -max_len=$max_len -print_final_stats=1 -artifact_prefix="$artifacts/")
   [ -f "$here/dictionaries/$target.dict" ] && options+=(-dict="$here/dictionaries/$target.dict")
+  [ "${MMRTM_FUZZ_KEEP_GOING:-0}" = 1 ] && options+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
   # Leaks count where the code is ours. VTK's readers and GDCM leak a few
   # hundred bytes on some error paths (reliability.md lists those found):
   # not ours to fix, and they would stop every run of these targets. Both
@@ -96,6 +102,8 @@ printf 'target\texecutions\tcorpus\tcoverage\tfeatures\tfindings\n' > "$build/fu
 for target in "${targets[@]}"; do
   log="$build/logs/$target.log"
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  # Fork mode prints no final statistics: its status lines count the executions.
+  [ -z "$runs" ] && runs=$(grep -oE '^#[0-9]+: cov' "$log" | tail -1 | tr -dc '0-9' || true)
   last=$(grep -E '^#[0-9]+' "$log" | grep -o 'cov: [0-9]* ft: [0-9]*' | tail -1)
   cov=$(echo "$last" | awk '{print $2}') ft=$(echo "$last" | awk '{print $4}')
   corpus=$(find "$build/corpus/$target" -type f | wc -l)

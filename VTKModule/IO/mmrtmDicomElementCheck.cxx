@@ -58,7 +58,10 @@ struct Syntax {
 // GDCM gives up on the file as not DICOM (a text file in the folder).
 std::optional<Syntax> GuessSyntax(const unsigned char* first) {
   const unsigned group = U16(first, false), element = U16(first + 2, false);
-  const bool vr = IsVr(first + 4);
+  // Outside the meta group GDCM asks VR::GetVRType, which also knows "??"
+  // (its name for an invalid VR): a file starting with one was read as
+  // explicit VR, and GDCM asserted on it (a fuzz finding).
+  const bool vr = IsVr(first + 4) || (group != 0x0002 && first[4] == '?' && first[5] == '?');
   if (group == 0x0002 || group == 0x0008 || element == 0x0010) return Syntax{vr, false};
   if (group == 0x0800) return Syntax{vr, true};  // group 8, big endian (ACR-NEMA)
   if (vr) return Syntax{true, group > 0xFF || element > 0xFF};
@@ -155,6 +158,16 @@ std::string CheckDicomElementLengths(const std::string& file) {
       } else {
         length = U16(b + 6, big);
       }
+    } else if (group != 0xFFFE && !inMeta && syntax.explicitVr) {
+      // Explicit VR with two bytes that are no VR: GDCM reads the dataset
+      // again as "VR16 explicit", taking them for a VR with a 16-bit length
+      // (it then asserted on 6 bytes left after such an element, where the
+      // walk had read a 32-bit length to the end of the file: a fuzz finding).
+      length = U16(b + 6, big);
+      // GDCM gives up on (0000,0000) read so, with a length of 0, and then
+      // asserted (a fuzz finding).
+      if (group == 0 && element == 0 && length == 0)
+        return "element (0000,0000) at byte " + std::to_string(pos) + " has no value representation (corrupt)";
     }
     const std::string where = "element (" + Hex4(group) + "," + Hex4(element) + ") at byte " + std::to_string(pos);
     pos += header;
@@ -162,6 +175,8 @@ std::string CheckDicomElementLengths(const std::string& file) {
     if (group == 0x0002 && (length == 0xFFFFFFFFu || (vr[0] == 'S' && vr[1] == 'Q')))
       return where + " is a sequence or has an undefined length in the file meta information (corrupt)";
     if (group == 0x7FE0 && element == 0x0010 && length == 0xFFFFFFFFu) {
+      if (vr[0] && !(vr[0] == 'O' && (vr[1] == 'B' || vr[1] == 'W')))  // GDCM asserts OB or OW
+        return where + ": encapsulated pixel data must be OB or OW, not " + std::string(vr, 2) + " (corrupt)";
       fragments = true;  // encapsulated (compressed) pixel data: items of raw bytes follow
       continue;
     }
@@ -170,6 +185,13 @@ std::string CheckDicomElementLengths(const std::string& file) {
       const std::string problem = CheckJpeg2000Size(in, pos, rows, columns, samples);
       if (!problem.empty()) return where + ": " + problem;
     }
+    // An undefined length belongs to sequences (SQ, UN) and encapsulated
+    // pixel data; GDCM asserts on one in any other explicit VR element (a
+    // fuzz finding).
+    if (length == 0xFFFFFFFFu && vr[0] && group != 0xFFFE && !(vr[0] == 'S' && vr[1] == 'Q') &&
+        !(vr[0] == 'U' && vr[1] == 'N'))
+      return where + " (" + std::string(vr, 2) + ") has an undefined length, which only sequences and " +
+             "encapsulated pixel data may have (corrupt)";
     if (length == 0xFFFFFFFFu) continue;  // undefined length: its items and delimiters follow
     if (length > size - pos)
       return where + " says its value is " + std::to_string(length) + " bytes, but only " +

@@ -57,8 +57,17 @@ MetaImageHeader ReadMetaImageHeader(const std::string& path) {
       if (c < 0x20 && c != '\t' && c != '\r')
         throw InputError(path + ": line " + std::to_string(number) +
                          " of the MetaImage header holds a control character (binary data in the header?)");
-    const size_t eq = line.find('=');
-    if (eq == std::string::npos) continue;
+    // metaio ends a key at '=' or ':' and reads its value from past the
+    // next one, on a later line when this one has none: a garbled line
+    // without either hid the next ElementDataFile from metaio and showed it
+    // another one (a fuzz finding). So every line that is not blank is a
+    // "Key = Value" (or "Key: Value") pair, as metaio reads it.
+    const size_t eq = line.find_first_of("=:");
+    if (eq == std::string::npos) {
+      if (Trim(line).empty()) continue;
+      throw InputError(path + ": line " + std::to_string(number) + " of the MetaImage header has no '=' (" +
+                       Trim(line).substr(0, 40) + ")");
+    }
     const std::string key = Trim(line.substr(0, eq));
     if (h.fields.count(key)) throw InputError(path + ": the MetaImage header gives " + key + " twice");
     h.fields[key] = Trim(line.substr(eq + 1));
@@ -185,6 +194,19 @@ void CheckMetaImageFilePattern(const std::string& path, const std::string& value
 // the data that holds them (CheckDeclaredVoxelBytes), and the data file is
 // there (metaio leaks its buffers when it is not: found by fuzzing).
 void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& h) {
+  // metaio keeps up to 10 axes in fixed arrays and reads NDims numbers for
+  // every per-axis field: an NDims of 2e17 kept it reading for minutes (a
+  // fuzz finding), so NDims must be a whole number from 1 to 10.
+  const std::string ndims = Field(h, "NDims");
+  if (!ndims.empty()) {
+    const std::optional<long long> n = IntegerWord(ndims);
+    if (!n || *n < 1 || *n > 10) throw InputError(path + ": NDims must be a whole number from 1 to 10: " + ndims);
+    // metaio reads NDims sizes whatever the line holds, into the next line
+    // when it holds fewer.
+    const size_t sizes = PositiveIntegers(path, "DimSize", Field(h, "DimSize")).size();
+    if (sizes != (size_t)*n)
+      throw InputError(path + ": DimSize gives " + std::to_string(sizes) + " sizes for NDims " + ndims);
+  }
   // Every word of DimSize a positive integer: metaio reads "1-6" as a size
   // and allocated a negative number of bytes (a fuzz finding).
   const std::vector<int64_t> dims = PositiveIntegers(path, "DimSize", Field(h, "DimSize"));

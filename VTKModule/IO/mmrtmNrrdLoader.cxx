@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <set>
@@ -43,6 +44,11 @@ struct NrrdHeader {
   int typeSize = 0;              // bytes per value of `type`; 0 if unknown
   std::string dataFile;          // `data file` as written; "" when the data is attached
   int64_t headerBytes = 0;       // the header and its blank line
+  // How many sizes vtkNrrdReader reads: its axis count when it meets
+  // `sizes`, which `space` (3) and `space dimension` reset after
+  // `dimension`. -1 when there is no `sizes`.
+  int vtkSizeCount = -1;
+  bool vtkFirstSpacingZero = false;  // its guess of a vector axis also looks at this
 };
 
 // Bytes per value of a NRRD `type` (teem's names and aliases); 0 if unknown
@@ -137,6 +143,7 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
   NrrdHeader h;
   const std::vector<std::string> lines = ReadNrrdHeaderLines(path, &h.headerBytes);
   std::set<std::string> seen;
+  int vtkAxes = 0;  // vtkNrrdReader's axis count as it reads the lines
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::string& line = lines[i];
     if (line[0] == '#') continue;
@@ -157,12 +164,17 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
       throw InputError(path + ": the NRRD header gives '" + field + "' before 'dimension' (the format wants dimension first)");
     if (field == "dimension") {
       h.dimension = std::atoi(value.c_str());
+      vtkAxes = h.dimension;
+    } else if (field == "space dimension") {
+      vtkAxes = std::atoi(value.c_str());
     } else if (field == "sizes") {
+      h.vtkSizeCount = vtkAxes;
       // Every word a positive integer: vtkNrrdReader reads "2t" as a size
       // too and then reads voxels into a null buffer (a fuzz finding).
       h.sizes = PositiveIntegers(path, "NRRD 'sizes'", value);
     } else if (field == "space") {
       h.space = ToLower(value);
+      vtkAxes = 3;
     } else if (field == "encoding") {
       h.encoding = ToLower(value);
     } else if (field == "type") {
@@ -172,12 +184,14 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
     } else if (field == "space directions") {
       h.hasSpaceDirections = true;
       for (const std::string& token : SplitNrrdVectors(value)) h.directions.push_back(ParseNrrdVector(token, path));
+      h.vtkFirstSpacingZero = !h.directions.empty() && (!h.directions[0] || Dot(*h.directions[0], *h.directions[0]) == 0.0);
     } else if (field == "space origin") {
       h.origin = ParseNrrdVector(value, path);
     } else if (field == "spacings") {
       std::istringstream in(value);
       std::string token;
       while (in >> token) h.spacings.push_back(ToLower(token) == "nan" ? std::nan("") : std::atof(token.c_str()));
+      h.vtkFirstSpacingZero = !h.spacings.empty() && h.spacings[0] == 0.0;
     }
   }
   if (h.encoding.empty()) h.encoding = "raw";
@@ -185,6 +199,28 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
   if (h.typeSize == 0) throw InputError(path + ": the NRRD header has no 'type' of a known kind");
   if (h.dimension <= 0 || (int)h.sizes.size() != h.dimension)
     throw InputError(path + ": NRRD header has no valid 'dimension' and 'sizes'");
+  // vtkNrrdReader sizes its axes by `space` or `space dimension` when they
+  // come between `dimension` and `sizes`: with none left, or with more than
+  // the file has, it indexed an empty list (a fuzz finding) or allocated
+  // what `space dimension` promised.
+  if (h.vtkSizeCount < 1 || h.vtkSizeCount > h.dimension)
+    throw InputError(path + ": the NRRD header's 'space dimension' or 'space' before 'sizes' gives " +
+                     std::to_string(h.vtkSizeCount) + " axes for a dimension of " + std::to_string(h.dimension));
+  // The axes vtkNrrdReader reads from the file: it takes a first axis of 9
+  // samples or fewer (or of no spacing), or a fourth axis, for vector
+  // components, and one axis for the files when the data is split. Its
+  // raw and text reads open the file only for 2 or 3 axes, and read
+  // through a null stream otherwise (fuzz findings: one axis; two axes, the
+  // first of 2 samples).
+  const bool vectorAxis = h.vtkSizeCount > 3 || h.sizes[0] <= 9 || h.vtkFirstSpacingZero;
+  const int fileAxes = h.vtkSizeCount - (vectorAxis ? 1 : 0);
+  std::istringstream dataFileWords(h.dataFile);
+  std::vector<std::string> words{std::istream_iterator<std::string>(dataFileWords), {}};
+  const bool split = !words.empty() && (words[0] == "LIST" || words.size() >= 4);
+  if (split ? fileAxes != 3 : (fileAxes < 2 || fileAxes > 3))
+    throw InputError(path + ": vtkNrrdReader would read " + std::to_string(split ? fileAxes - 1 : fileAxes) + " image axes from " +
+                     (split ? "each of its data files (it reads 2)" : "this NRRD file (it reads 2 or 3)") +
+                     (vectorAxis ? ", taking the first axis for vector components" : ""));
   if (h.hasSpaceDirections && (int)h.directions.size() != h.dimension)
     throw InputError(path + ": NRRD 'space directions' has " + std::to_string(h.directions.size()) +
                      " entries for " + std::to_string(h.dimension) + " axes");
