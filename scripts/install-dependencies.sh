@@ -12,6 +12,7 @@ packages=(
   qt6-base-dev libqt6opengl6-dev libqt6openglwidgets6 libxkbcommon-dev   # the Qt 6 viewer
   ninja-build              # the VTK 9.6 SDK and the wheel build (scripts/make-vtk-sdk.sh)
   python3-venv             # .venv: Mitsuba 3, numpy, matplotlib (accuracy checks and charts)
+  libllvm16                # Mitsuba's vectorised llvm_ad_rgb variant (Testing/Accuracy)
   clang-14 libclang-rt-14-dev   # libFuzzer + sanitizer runtimes (Testing/Fuzz)
   invesalius-examples   # the default input: Cranium.inv3
   debootstrap           # the ParaView root of the plugin's build and tests (scripts/paraview-root.sh)
@@ -34,11 +35,14 @@ fi
 # independent renderer), numpy and matplotlib. CMake finds it at .venv.
 here="$(cd "$(dirname "$0")/.." && pwd)"
 venv="$here/.venv"
-if ! "$venv/bin/python" -c "import mitsuba, numpy, matplotlib" 2>/dev/null; then
+# Reinstalled when the pins change (a dry run that needs no download says
+# whether what is installed satisfies them).
+requirements="$here/Testing/Accuracy/requirements.txt"
+if ! "$venv/bin/python" -m pip install --dry-run --no-index --disable-pip-version-check --quiet \
+       -r "$requirements" >/dev/null 2>&1; then
   echo "Setting up $venv (mitsuba, numpy, matplotlib)" >&2
-  /usr/bin/python3 -m venv "$venv"
-  "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
-    -r "$here/Testing/Accuracy/requirements.txt"
+  [ -x "$venv/bin/python" ] || /usr/bin/python3 -m venv "$venv"
+  "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r "$requirements"
 fi
 
 # The VTK 9.6 flavour (Documentation/vtk-flavours.md): a venv of Debian's

@@ -5,6 +5,7 @@
 // With no INPUT it renders the head CT of Debian's invesalius-examples
 // package with the ct-bone preset. Progress goes to stderr, the image to the
 // named file; the exit code is 0 only on success. See --help.
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -51,7 +52,11 @@ options:
                         "label_materials" (ct-organs), which make a material per label
   --width W             image width in pixels (default: scene, else 512)
   --height H            image height in pixels (default: scene, else 512)
-  --spp N               samples per pixel (default: scene, else 64)
+  --spp N               samples per pixel (default: scene, else 64); with
+                        --noise-target, the most it renders
+  --noise-target R      stop once the image's relative noise (its estimated RMS
+                        standard error over its mean luminance) is at most R, e.g.
+                        0.01; checked after passes of 4, 8, 16 ... 64 spp
   --seed S              random seed (default: scene, else 0)
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
@@ -98,6 +103,7 @@ struct Options {
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
   bool quiet = false, listSeries = false;
+  double noiseTarget = 0;  // 0: render all --spp samples
 };
 
 [[noreturn]] void UsageError(const std::string& msg) {
@@ -173,6 +179,10 @@ Options ParseArguments(int argc, char** argv) {
     else if (a == "--output-variance") o.outputVariance = value();
     else if (a == "--ray-march-step") o.render["ray_march_step"] = ParseReal(a, value());
     else if (a == "--stats-json") o.statsJson = value();
+    else if (a == "--noise-target") {
+      o.noiseTarget = ParseReal(a, value());
+      if (!(o.noiseTarget > 0 && o.noiseTarget < 1)) UsageError("--noise-target expects a relative noise in (0, 1), e.g. 0.01");
+    }
     else if (a == "--quiet") o.quiet = true;
     else if (a.size() > 1 && a[0] == '-') UsageError("unknown option " + a);
     else if (o.input.empty()) o.input = a;
@@ -301,7 +311,22 @@ int Run(const Options& o) {
                  rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
                  view.majorants.globalMajorant);
   ProgressBar bar(!o.quiet);
-  renderer->Render(scene, view, film, rs.samplesPerPixel, &counters, [&](int d, int t) { bar(d, t); });
+  // With a noise target the samples come in passes that double up to 64 spp
+  // (a pass's cost is mostly its samples: each checks the noise once), and
+  // rendering stops after the first pass whose image meets the target. The
+  // passes continue one sample sequence, so the image equals the one
+  // rendered in one go with as many samples.
+  const int spp = rs.samplesPerPixel;
+  int pass = o.noiseTarget > 0 ? 4 : spp;
+  bool reachedTarget = false;
+  for (int done = 0; done < spp && !reachedTarget; done += pass, pass = std::min(2 * pass, 64)) {
+    pass = std::min(pass, spp - done);
+    renderer->Render(scene, view, film, pass, &counters, [&](int d, int t) {
+      bar((int)(1000.0 * (done + pass * (double)d / t) / spp), 1000);
+    });
+    reachedTarget = o.noiseTarget > 0 && film.Samples() >= 2 && film.Noise().relative <= o.noiseTarget;
+  }
+  if (reachedTarget) bar(1000, 1000);
   const double renderSeconds = bar.Seconds();
 
   mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, film.ToneMapped(rs.exposure, rs.toneMapper));
@@ -311,14 +336,17 @@ int Run(const Options& o) {
   const mmrtm::NoiseEstimate noise = film.Noise();
   const double samples = (double)film.Width() * film.Height() * film.Samples();
   if (!o.quiet)
-    std::fprintf(stderr, "Wrote %s: %.2f s render, %.3g samples/s, relative noise %.3g\n", o.output.c_str(),
-                 renderSeconds, samples / renderSeconds, noise.relative);
+    std::fprintf(stderr, "Wrote %s: %u spp%s, %.2f s render, %.3g samples/s, relative noise %.3g\n",
+                 o.output.c_str(), film.Samples(), reachedTarget ? " (noise target reached)" : "", renderSeconds,
+                 samples / renderSeconds, noise.relative);
   if (!o.statsJson.empty()) {
     json stats = {
         {"input", input},
         {"width", film.Width()},
         {"height", film.Height()},
         {"spp", film.Samples()},
+        {"noise_target", o.noiseTarget > 0 ? json(o.noiseTarget) : json(nullptr)},
+        {"stopped_on", reachedTarget ? "noise_target" : "spp"},
         {"threads", rs.threads > 0 ? rs.threads : (int)std::thread::hardware_concurrency()},
         {"backend", renderer->Description()},
         {"seed", rs.integrator.seed},

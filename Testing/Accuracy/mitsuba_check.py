@@ -220,7 +220,8 @@ def main():
     parser.add_argument("--spp", type=int, help="our samples per pixel")
     parser.add_argument("--mitsuba-spp", type=int, help="Mitsuba's samples per pixel per batch")
     parser.add_argument("--batches", type=int, default=16, help="independent Mitsuba batches (for its variance)")
-    parser.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (scalar_rgb or llvm_ad_rgb)")
+    parser.add_argument("--variant", default=acc.mitsuba_variant(),
+                        help="Mitsuba variant (default: llvm_ad_rgb where libLLVM 16 is installed, else scalar_rgb)")
     parser.add_argument("--save", help="folder for both images and variances (PFM) and the figures (JSON); "
                         "without --ci also draws Documentation/images/mitsuba_check.png")
     args = parser.parse_args()

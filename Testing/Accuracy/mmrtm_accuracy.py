@@ -26,6 +26,19 @@ REFERENCE_DIR = Path(os.environ.get("MMRTM_REFERENCE_DIR", BUILD / "references")
 RENDER = BUILD / "bin" / "mmrtm-render"
 DOC_IMAGES = ROOT / "Documentation" / "images"
 
+# Mitsuba's vectorised LLVM variant loads libLLVM at run time; Debian 12's
+# libllvm16 is the one that works with the pinned Dr.Jit (requirements.txt).
+LIBLLVM = Path("/usr/lib/x86_64-linux-gnu/libLLVM-16.so.1")
+
+
+def mitsuba_variant():
+    """The Mitsuba variant to compare with: llvm_ad_rgb (vectorised) where
+    libLLVM 16 is installed, else scalar_rgb. Call before importing mitsuba."""
+    if os.environ.get("DRJIT_LIBLLVM_PATH") or LIBLLVM.exists():
+        os.environ.setdefault("DRJIT_LIBLLVM_PATH", str(LIBLLVM))
+        return "llvm_ad_rgb"
+    return "scalar_rgb"
+
 
 def data_path(name):
     return str(DATA / name)

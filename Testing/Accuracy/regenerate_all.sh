@@ -13,6 +13,7 @@ log() { echo "== $* ($(date +%H:%M:%S))" >&2; }
 log "references";            "$py" make_references.py --spp "${REFERENCE_SPP:-2048}"
 log "speed against accuracy"; "$py" speed_accuracy.py
 log "Mitsuba 3 check";       "$py" mitsuba_check.py --save ../../build/references/mitsuba | tee ../../build/references/mitsuba.log
+log "noise target";          "$py" noise_target_check.py --json ../../build/references/noise_target.json
 log "failure cases";         "$py" failure_charts.py
 log "channels and shadow";   "$py" channels_and_shadow.py
 log "plain-scene overhead";  "$py" plain_scene_overhead.py

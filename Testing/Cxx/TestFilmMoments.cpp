@@ -58,6 +58,46 @@ TEST(FilmMoments, CombinedFilmIsTheFilmOfAllSamples) {
   EXPECT_THROW(Film::FromMoments(w + 1, h, 8, combined.Moments()), std::invalid_argument);
 }
 
+// The noise a noise target stops on: where the channels move together (a
+// grey path throughput), exactly the standard error of the luminance mean;
+// where they are independent, no less than it (an upper bound, never an
+// underestimate: summing channel variances as independent gave 0.75 of the
+// true error in the first case).
+TEST(FilmNoise, IsTheLuminanceStandardErrorOrAnUpperBound) {
+  const int w = 3, h = 2, samples = 50;
+  const double wr = 0.2126, wg = 0.7152, wb = 0.0722;
+  for (bool correlated : {true, false}) {
+    Film film(w, h);
+    std::mt19937 rng(11);
+    std::exponential_distribution<float> u(1.f);  // heavy-ish tails, as radiance has
+    std::vector<double> sum(w * h), sumSq(w * h);
+    for (int s = 1; s <= samples; ++s) {
+      for (int i = 0; i < w * h; ++i) {
+        const float a = u(rng);
+        const RGB L = correlated ? RGB(a, 0.5f * a, 2.f * a) : RGB(a, u(rng), u(rng));
+        film.View().AddSample(i % w, i / w, L, 1.f, s);
+        const double lum = wr * L.r + wg * L.g + wb * L.b;
+        sum[i] += lum;
+        sumSq[i] += lum * lum;
+      }
+      film.AddSamples(1);
+    }
+    double meanVar = 0, meanLum = 0;  // of the luminance mean, from the luminance samples themselves
+    for (int i = 0; i < w * h; ++i) {
+      const double mean = sum[i] / samples;
+      meanVar += (sumSq[i] - samples * mean * mean) / (samples - 1) / samples / (w * h);
+      meanLum += mean / (w * h);
+    }
+    const NoiseEstimate noise = film.Noise();
+    EXPECT_NEAR(meanLum, noise.meanLuminance, 1e-4 * meanLum);
+    if (correlated)
+      EXPECT_NEAR(std::sqrt(meanVar), noise.rmsStandardError, 1e-3 * std::sqrt(meanVar));
+    else
+      EXPECT_GT(noise.rmsStandardError, 1.2 * std::sqrt(meanVar));
+    EXPECT_NEAR(noise.rmsStandardError / noise.meanLuminance, noise.relative, 1e-12);
+  }
+}
+
 TEST(FilmMoments, TwoSeedsCombinedAgreeWithASerialRenderOfTwiceTheSamples) {
   Scene scene = test::MakeMediumScene(
       test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }), 1.f,

@@ -152,6 +152,34 @@ class RenderCli(unittest.TestCase):
             self.expect_failure(r, "--backend cuda: ")
         self.expect_failure(self.run_render(HEADSQ, "--backend", "gpu"), "--backend expects auto, cpu or cuda", code=2)
 
+    def render_linear(self, name, *args):
+        stats, pfm = os.path.join(self.dir, name + ".json"), os.path.join(self.dir, name + ".pfm")
+        r = self.run_render(HEADSQ, "--width", "40", "--height", "30", "--seed", "5", "--stats-json", stats,
+                            "--output-linear", pfm, *args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(stats) as f, open(pfm, "rb") as g:
+            return json.load(f), g.read()
+
+    def test_noise_target(self):
+        # A target it cannot reach: all --spp samples, in passes of 4, 8 and
+        # 4 that continue one sample sequence: the same image, to the bit, as
+        # one pass of 16.
+        whole, whole_pixels = self.render_linear("whole", "--spp", "16")
+        passes, pass_pixels = self.render_linear("passes", "--spp", "16", "--noise-target", "1e-6")
+        self.assertEqual((passes["spp"], passes["stopped_on"], passes["noise_target"]), (16, "spp", 1e-6))
+        self.assertEqual((whole["stopped_on"], whole["noise_target"]), ("spp", None))
+        self.assertEqual(pass_pixels, whole_pixels)
+        # A reachable one: it stops early, on a noise at most the target,
+        # after more samples than a pass of 4 (which is noisier than 0.1 here).
+        stopped, _ = self.render_linear("stopped", "--spp", "4096", "--noise-target", "0.1")
+        self.assertEqual(stopped["stopped_on"], "noise_target")
+        self.assertLessEqual(stopped["noise"]["relative"], 0.1)
+        self.assertGreater(stopped["spp"], 4)
+        self.assertLess(stopped["spp"], 4096)
+        os.remove(self.png)
+        self.expect_failure(self.run_render(HEADSQ, "--noise-target", "0"), "--noise-target", code=2)
+        self.expect_failure(self.run_render(HEADSQ, "--noise-target", "two"), "--noise-target", code=2)
+
     def test_degenerate_volumes(self):
         # One voxel, a 1 x 1 x 1000 line, a single slice: nothing to render,
         # said clearly instead of an empty image (or a camera error).
@@ -228,7 +256,7 @@ class RenderCli(unittest.TestCase):
         r = subprocess.run([RENDER, "--help"], capture_output=True, text=True, timeout=60)
         self.assertEqual(r.returncode, 0)
         for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--backend", "--width", "--height", "--spp", "--seed", "--threads",
-                       "--estimator", "--output", "--output-linear", "--stats-json"]:
+                       "--estimator", "--output", "--output-linear", "--stats-json", "--noise-target"]:
             self.assertIn(option, r.stdout)
 
 

@@ -13,7 +13,9 @@ namespace mmrtm {
 
 struct NoiseEstimate {
   double meanLuminance = 0;     // over all pixels
-  double rmsStandardError = 0;  // root mean square over pixels of the standard error of the luminance mean
+  // Root mean square over pixels of the standard error of the luminance
+  // mean, bounded from above by the channels' standard errors (Film::Noise).
+  double rmsStandardError = 0;
   double relative = 0;          // rmsStandardError / meanLuminance
 };
 
