@@ -13,6 +13,7 @@
 #include <fstream>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace mmrtm {
 namespace {
@@ -125,9 +126,11 @@ std::string CheckDicomElementLengths(const std::string& file) {
     inMeta = U16(b, false) == 0x0002;
   }
   bool fragments = false;  // inside encapsulated pixel data
+  std::vector<uint64_t> ends;  // where the sequences and items of defined length the walk is in end
   std::string transferSyntax;
   unsigned rows = 0, columns = 0, samples = 1;  // (0028,0010), (0028,0011), (0028,0002) as read
   while (pos + 8 <= size) {
+    while (!ends.empty() && pos >= ends.back()) ends.pop_back();  // left them
     if (!readAt(pos, 8)) return "";
     if (inMeta && U16(b, false) != 0x0002) {
       inMeta = false;
@@ -159,15 +162,13 @@ std::string CheckDicomElementLengths(const std::string& file) {
         length = U16(b + 6, big);
       }
     } else if (group != 0xFFFE && !inMeta && syntax.explicitVr) {
-      // Explicit VR with two bytes that are no VR: GDCM reads the dataset
-      // again as "VR16 explicit", taking them for a VR with a 16-bit length
-      // (it then asserted on 6 bytes left after such an element, where the
-      // walk had read a 32-bit length to the end of the file: a fuzz finding).
-      length = U16(b + 6, big);
-      // GDCM gives up on (0000,0000) read so, with a length of 0, and then
-      // asserted (a fuzz finding).
-      if (group == 0 && element == 0 && length == 0)
-        return "element (0000,0000) at byte " + std::to_string(pos) + " has no value representation (corrupt)";
+      // Explicit VR with two bytes that are no VR: GDCM then reads the
+      // dataset again by its fallbacks for broken files ("VR16 explicit",
+      // implicit VR), and on fuzzed files those asserted (on a few bytes
+      // left, on a tag (0000,0000), on a stream left bad) or allocated
+      // gigabytes (fuzz findings). Such a file is refused.
+      return "element (" + Hex4(group) + "," + Hex4(element) + ") at byte " + std::to_string(pos) +
+             " has no valid value representation, in a dataset encoded with explicit ones (corrupt)";
     }
     const std::string where = "element (" + Hex4(group) + "," + Hex4(element) + ") at byte " + std::to_string(pos);
     pos += header;
@@ -196,11 +197,21 @@ std::string CheckDicomElementLengths(const std::string& file) {
     if (length > size - pos)
       return where + " says its value is " + std::to_string(length) + " bytes, but only " +
              std::to_string(size - pos) + " are left in the file (truncated or corrupt)";
+    // GDCM reads a sequence or an item of defined length within that
+    // length: an element that ran past its end made GDCM fail and assert
+    // (a fuzz finding).
+    if (!ends.empty() && pos + length > ends.back())
+      return where + " runs past the end of the sequence or item that holds it (corrupt)";
     // Items of a sequence and sequences: their elements follow and are
     // checked in turn. A fragment of pixel data is bytes: skipped.
-    if ((group == 0xFFFE && !fragments) || (vr[0] == 'S' && vr[1] == 'Q')) continue;
-    if (!vr[0] && length >= 8 && readAt(pos, 4) && U16(b, big) == 0xFFFE && U16(b + 2, big) == 0xE000)
+    if ((group == 0xFFFE && !fragments) || (vr[0] == 'S' && vr[1] == 'Q')) {
+      ends.push_back(pos + length);
+      continue;
+    }
+    if (!vr[0] && length >= 8 && readAt(pos, 4) && U16(b, big) == 0xFFFE && U16(b + 2, big) == 0xE000) {
+      ends.push_back(pos + length);
       continue;  // a sequence in implicit VR: its first item follows
+    }
     if (group == 0x0028 && (element == 0x0010 || element == 0x0011 || element == 0x0002) && length == 2 &&
         readAt(pos, 2)) {
       const unsigned value = U16(b, big);
