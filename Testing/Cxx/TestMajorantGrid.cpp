@@ -215,16 +215,22 @@ TEST(Refit, ByteTablesGiveTheSameLeafMajorantsAsTheBins) {
   EXPECT_GT(nonZero, 100);
 }
 
+// Writes `value` into the voxels [lo, hi] of the scene's 64 x 64 x N int16
+// proxy 0 (ct_head_headsq), as an editing tool does before it marks the region.
+void PaintBlock(Scene& scene, const std::array<int, 3>& lo, const std::array<int, 3>& hi, int16_t value) {
+  int16_t* voxels = reinterpret_cast<int16_t*>(scene.proxies[0].voxels.data());
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x) voxels[x + 64 * (y + 64 * z)] = value;
+}
+
 TEST(Refit, AfterADataChangeInARegionEqualsAFullRebuild) {
   HostVolume ct = LoadVolume(Data("ct_head_headsq.nrrd"));
   Scene scene = SceneWith({ct}, {CCTF({500.f, 1500.f}, {0.f, 1.f})}, 1.f, MajorantKind::Octree);
   scene.Build();
   // Paint a bright block into the data, then update only that region.
   const std::array<int, 3> lo{20, 30, 40}, hi{27, 33, 52};
-  int16_t* voxels = reinterpret_cast<int16_t*>(scene.proxies[0].voxels.data());
-  for (int z = lo[2]; z <= hi[2]; ++z)
-    for (int y = lo[1]; y <= hi[1]; ++y)
-      for (int x = lo[0]; x <= hi[0]; ++x) voxels[x + 64 * (y + 64 * z)] = 3000;
+  PaintBlock(scene, lo, hi, 3000);
   const double fullBuildSeconds = scene.Grid()->LastBuildSeconds();
   scene.MarkRegionModified(lo, hi);
   SceneView updated = scene.Build();
@@ -244,10 +250,7 @@ TEST(Refit, ARegionEditedBeyondTheValueRangeStillBoundsTheExtinction) {
   Scene scene = SceneWith({ct}, {CCTF({500.f, 4500.f, 5000.f}, {0.f, 0.f, 1.f})}, 2.f, MajorantKind::Octree);
   scene.Build();
   const std::array<int, 3> lo{20, 30, 40}, hi{27, 33, 52};
-  int16_t* voxels = reinterpret_cast<int16_t*>(scene.proxies[0].voxels.data());
-  for (int z = lo[2]; z <= hi[2]; ++z)
-    for (int y = lo[1]; y <= hi[1]; ++y)
-      for (int x = lo[0]; x <= hi[0]; ++x) voxels[x + 64 * (y + 64 * z)] = 5000;
+  PaintBlock(scene, lo, hi, 5000);
   scene.MarkRegionModified(lo, hi);
   SceneView updated = scene.Build();
   const MajorantGridView& g = scene.Grid()->View();

@@ -194,22 +194,21 @@ void CheckMetaImageFilePattern(const std::string& path, const std::string& value
 // the data that holds them (CheckDeclaredVoxelBytes), and the data file is
 // there (metaio leaks its buffers when it is not: found by fuzzing).
 void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& h) {
+  // Every word of DimSize a positive integer: metaio reads "1-6" as a size
+  // and allocated a negative number of bytes (a fuzz finding).
+  const std::vector<int64_t> dims = PositiveIntegers(path, "DimSize", Field(h, "DimSize"));
   // metaio keeps up to 10 axes in fixed arrays and reads NDims numbers for
   // every per-axis field: an NDims of 2e17 kept it reading for minutes (a
-  // fuzz finding), so NDims must be a whole number from 1 to 10.
+  // fuzz finding), so NDims must be a whole number from 1 to 10. It reads
+  // NDims sizes whatever the line holds, into the next line when it holds
+  // fewer.
   const std::string ndims = Field(h, "NDims");
   if (!ndims.empty()) {
     const std::optional<long long> n = IntegerWord(ndims);
     if (!n || *n < 1 || *n > 10) throw InputError(path + ": NDims must be a whole number from 1 to 10: " + ndims);
-    // metaio reads NDims sizes whatever the line holds, into the next line
-    // when it holds fewer.
-    const size_t sizes = PositiveIntegers(path, "DimSize", Field(h, "DimSize")).size();
-    if (sizes != (size_t)*n)
-      throw InputError(path + ": DimSize gives " + std::to_string(sizes) + " sizes for NDims " + ndims);
+    if (dims.size() != (size_t)*n)
+      throw InputError(path + ": DimSize gives " + std::to_string(dims.size()) + " sizes for NDims " + ndims);
   }
-  // Every word of DimSize a positive integer: metaio reads "1-6" as a size
-  // and allocated a negative number of bytes (a fuzz finding).
-  const std::vector<int64_t> dims = PositiveIntegers(path, "DimSize", Field(h, "DimSize"));
   // metaio reads an empty ElementDataFile as a stream it then sizes as -1
   // bytes (found by fuzzing).
   const std::string dataFile = Trim(Field(h, "ElementDataFile"));

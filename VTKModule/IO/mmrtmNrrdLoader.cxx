@@ -43,6 +43,11 @@ struct NrrdHeader {
   std::vector<double> spacings;  // per axis, from the older `spacings` field
   int typeSize = 0;              // bytes per value of `type`; 0 if unknown
   std::string dataFile;          // `data file` as written; "" when the data is attached
+  // How vtkNrrdReader reads `data file`: a first word "LIST" exactly is a
+  // list of files; four words or more are a name pattern (so
+  // "LISTslice%d.raw 1 2 0" is a pattern: a fuzz finding); fewer are one
+  // file name.
+  bool dataFileList = false, dataFilePattern = false;
   int64_t headerBytes = 0;       // the header and its blank line
   // How many sizes vtkNrrdReader reads: its axis count when it meets
   // `sizes`, which `space` (3) and `space dimension` reset after
@@ -181,6 +186,10 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
       h.typeSize = NrrdTypeSize(ToLower(value));
     } else if (field == "data file" || field == "datafile") {
       h.dataFile = value;
+      std::istringstream in(value);
+      const std::vector<std::string> words{std::istream_iterator<std::string>(in), {}};
+      h.dataFileList = !words.empty() && words[0] == "LIST";
+      h.dataFilePattern = !h.dataFileList && words.size() >= 4;
     } else if (field == "space directions") {
       h.hasSpaceDirections = true;
       for (const std::string& token : SplitNrrdVectors(value)) h.directions.push_back(ParseNrrdVector(token, path));
@@ -214,9 +223,7 @@ NrrdHeader ParseNrrdHeader(const std::string& path) {
   // first of 2 samples).
   const bool vectorAxis = h.vtkSizeCount > 3 || h.sizes[0] <= 9 || h.vtkFirstSpacingZero;
   const int fileAxes = h.vtkSizeCount - (vectorAxis ? 1 : 0);
-  std::istringstream dataFileWords(h.dataFile);
-  std::vector<std::string> words{std::istream_iterator<std::string>(dataFileWords), {}};
-  const bool split = !words.empty() && (words[0] == "LIST" || words.size() >= 4);
+  const bool split = h.dataFileList || h.dataFilePattern;
   if (split ? fileAxes != 3 : (fileAxes < 2 || fileAxes > 3))
     throw InputError(path + ": vtkNrrdReader would read " + std::to_string(split ? fileAxes - 1 : fileAxes) + " image axes from " +
                      (split ? "each of its data files (it reads 2)" : "this NRRD file (it reads 2 or 3)") +
@@ -265,17 +272,8 @@ void CheckNrrdFilePattern(const NrrdHeader& h, const std::string& path) {
 // split over several files (`data file: LIST` or a name pattern) is left to
 // the reader, once a pattern's counter is checked.
 void CheckNrrdDataSize(const NrrdHeader& h, const std::string& path) {
-  // As vtkNrrdReader tells them apart: a first word "LIST" exactly is a
-  // list; four words or more are a pattern (so "LISTslice%d.raw 1 2 0" is a
-  // pattern: a fuzz finding); fewer are one file name.
-  std::istringstream words(h.dataFile);
-  std::string first, word;
-  words >> first;
-  int wordCount = first.empty() ? 0 : 1;
-  while (words >> word) ++wordCount;
-  const bool list = first == "LIST", pattern = !list && wordCount >= 4;
-  if (pattern) CheckNrrdFilePattern(h, path);
-  if (list || pattern) return;
+  if (h.dataFilePattern) CheckNrrdFilePattern(h, path);
+  if (h.dataFileList || h.dataFilePattern) return;
   double count = 1;
   for (int64_t n : h.sizes) count *= (double)n;
   std::error_code ec;
