@@ -19,6 +19,7 @@
 
 #include <unistd.h>
 
+#include "adaptive_sampling.h"
 #include "image_io.h"
 #include "mmrtmVolumeLoader.h"
 #include "render_backend.h"
@@ -57,6 +58,13 @@ options:
   --noise-target R      stop once the image's relative noise (its estimated RMS
                         standard error over its mean luminance) is at most R, e.g.
                         0.01; checked after passes of 4, 8, 16 ... 64 spp
+  --light-sampling L    next-event estimation with several lights: resampled (one
+                        shadow ray, to a light chosen by its unshadowed contribution;
+                        default), one (a light chosen uniformly) or all (a shadow ray
+                        to every light)
+  --sampling S          uniform (every pixel --spp samples; default) or adaptive
+                        (a pilot pass, then each pixel's share of a mean of --spp
+                        in proportion to its neighbours' noise; unbiased)
   --seed S              random seed (default: scene, else 0)
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
@@ -104,6 +112,7 @@ struct Options {
   mmrtm::Backend backend = mmrtm::Backend::Auto;
   bool quiet = false, listSeries = false;
   double noiseTarget = 0;  // 0: render all --spp samples
+  bool adaptive = false;   // --sampling adaptive
 };
 
 [[noreturn]] void UsageError(const std::string& msg) {
@@ -183,7 +192,15 @@ Options ParseArguments(int argc, char** argv) {
       o.noiseTarget = ParseReal(a, value());
       if (!(o.noiseTarget > 0 && o.noiseTarget < 1)) UsageError("--noise-target expects a relative noise in (0, 1), e.g. 0.01");
     }
-    else if (a == "--quiet") o.quiet = true;
+    else if (a == "--light-sampling") {
+      const std::string v = value();
+      if (!mmrtm::ParseLightSampling(v)) UsageError("--light-sampling expects one, all or resampled, got '" + v + "'");
+      o.render["light_sampling"] = v;
+    } else if (a == "--sampling") {
+      const std::string v = value();
+      if (v != "uniform" && v != "adaptive") UsageError("--sampling expects uniform or adaptive, got '" + v + "'");
+      o.adaptive = v == "adaptive";
+    } else if (a == "--quiet") o.quiet = true;
     else if (a.size() > 1 && a[0] == '-') UsageError("unknown option " + a);
     else if (o.input.empty()) o.input = a;
     else UsageError("more than one INPUT given ('" + o.input + "' and '" + a + "')");
@@ -232,6 +249,54 @@ class ProgressBar {
 
 double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// Uniform sampling. With a noise target the samples come in passes that
+// double up to 64 spp (a pass's cost is mostly its samples: each checks the
+// noise once), and rendering stops after the first pass whose image meets
+// the target. The passes continue one sample sequence, so the image equals
+// the one rendered in one go with as many samples. Returns whether the
+// target was reached.
+bool RenderUniformly(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, const mmrtm::SceneView& view,
+                     mmrtm::Film& film, int spp, double noiseTarget, mmrtm::TraceCounters& counters,
+                     ProgressBar& bar) {
+  int pass = noiseTarget > 0 ? 4 : spp;
+  for (int done = 0; done < spp; done += pass, pass = std::min(2 * pass, 64)) {
+    pass = std::min(pass, spp - done);
+    renderer.Render(scene, view, film, pass, &counters, [&](int d, int t) {
+      bar((int)(1000.0 * (done + pass * (double)d / t) / spp), 1000);
+    });
+    if (noiseTarget > 0 && film.Samples() >= 2 && film.Noise().relative <= noiseTarget) return true;
+  }
+  return false;
+}
+
+// Adaptive sampling (adaptive_sampling.h): a uniform pilot pass (4 spp with
+// a noise target, else spp / 8 up to 8), then passes that bring the mean to
+// spp, or with a noise target to 8, 16, 32, 64 and then 64 more each, until
+// the target is met. Every pass splits its mean by the pilot's weights, so
+// a pixel's count never depends on its own samples. A pixel gets at most 16
+// times the mean.
+bool RenderAdaptively(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, const mmrtm::SceneView& view,
+                      mmrtm::Film& film, int spp, double noiseTarget, mmrtm::TraceCounters& counters,
+                      ProgressBar& bar) {
+  const int pilot = noiseTarget > 0 ? 4 : std::clamp(spp / 8, 2, 8);
+  film.TrackWork();
+  renderer.Render(scene, view, film, pilot, &counters,
+                  [&](int d, int t) { bar((int)(1000.0 * pilot * d / t / spp), 1000); });
+  if (noiseTarget > 0 && film.Noise().relative <= noiseTarget) return true;
+  const std::vector<float> weights = mmrtm::AdaptiveSampleWeights(film);
+  for (double mean = pilot; mean < spp;) {
+    const double before = film.MeanSamples();
+    mean = noiseTarget > 0 ? std::min<double>(spp, std::min(2 * mean, mean + 64)) : spp;
+    const std::vector<uint32_t> counts =
+        mmrtm::AdaptiveSampleCounts(film, weights, mean, (uint32_t)std::min(16.0 * mean, 1e9));
+    renderer.RenderTo(scene, view, film, counts, &counters, [&](int d, int t) {
+      bar((int)(1000.0 * (before + (mean - before) * d / t) / spp), 1000);
+    });
+    if (noiseTarget > 0 && film.Noise().relative <= noiseTarget) return true;
+  }
+  return false;
 }
 
 int ListSeries(const Options& o) {
@@ -311,21 +376,10 @@ int Run(const Options& o) {
                  rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
                  view.majorants.globalMajorant);
   ProgressBar bar(!o.quiet);
-  // With a noise target the samples come in passes that double up to 64 spp
-  // (a pass's cost is mostly its samples: each checks the noise once), and
-  // rendering stops after the first pass whose image meets the target. The
-  // passes continue one sample sequence, so the image equals the one
-  // rendered in one go with as many samples.
   const int spp = rs.samplesPerPixel;
-  int pass = o.noiseTarget > 0 ? 4 : spp;
-  bool reachedTarget = false;
-  for (int done = 0; done < spp && !reachedTarget; done += pass, pass = std::min(2 * pass, 64)) {
-    pass = std::min(pass, spp - done);
-    renderer->Render(scene, view, film, pass, &counters, [&](int d, int t) {
-      bar((int)(1000.0 * (done + pass * (double)d / t) / spp), 1000);
-    });
-    reachedTarget = o.noiseTarget > 0 && film.Samples() >= 2 && film.Noise().relative <= o.noiseTarget;
-  }
+  const bool reachedTarget =
+      o.adaptive && spp >= 4 ? RenderAdaptively(*renderer, scene, view, film, spp, o.noiseTarget, counters, bar)
+                             : RenderUniformly(*renderer, scene, view, film, spp, o.noiseTarget, counters, bar);
   if (reachedTarget) bar(1000, 1000);
   const double renderSeconds = bar.Seconds();
 
@@ -334,17 +388,21 @@ int Run(const Options& o) {
   if (!o.outputVariance.empty()) mmrtm::WritePFM(o.outputVariance, film.VarianceOfMeanImage());
 
   const mmrtm::NoiseEstimate noise = film.Noise();
-  const double samples = (double)film.Width() * film.Height() * film.Samples();
+  const double samples = (double)film.Width() * film.Height() * film.MeanSamples();
   if (!o.quiet)
-    std::fprintf(stderr, "Wrote %s: %u spp%s, %.2f s render, %.3g samples/s, relative noise %.3g\n",
-                 o.output.c_str(), film.Samples(), reachedTarget ? " (noise target reached)" : "", renderSeconds,
-                 samples / renderSeconds, noise.relative);
+    std::fprintf(stderr, "Wrote %s: %.4g spp%s%s, %.2f s render, %.3g samples/s, relative noise %.3g\n",
+                 o.output.c_str(), film.MeanSamples(), film.Adaptive() ? " (mean, adaptive)" : "",
+                 reachedTarget ? " (noise target reached)" : "", renderSeconds, samples / renderSeconds,
+                 noise.relative);
   if (!o.statsJson.empty()) {
     json stats = {
         {"input", input},
         {"width", film.Width()},
         {"height", film.Height()},
-        {"spp", film.Samples()},
+        {"spp", film.Adaptive() ? json(film.MeanSamples()) : json(film.Samples())},
+        {"sampling", film.Adaptive() ? "adaptive" : "uniform"},
+        {"spp_min", film.Samples()},
+        {"spp_max", film.MaxSamples()},
         {"noise_target", o.noiseTarget > 0 ? json(o.noiseTarget) : json(nullptr)},
         {"stopped_on", reachedTarget ? "noise_target" : "spp"},
         {"threads", rs.threads > 0 ? rs.threads : (int)std::thread::hardware_concurrency()},

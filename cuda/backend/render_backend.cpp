@@ -22,6 +22,10 @@ class CpuBackend : public Renderer {
               const Progress& progress, const std::atomic<bool>* cancel) override {
     return cpu_.Render(view, film, spp, counters, progress, cancel);
   }
+  bool RenderTo(const Scene&, const SceneView& view, Film& film, const std::vector<uint32_t>& targetCounts,
+                TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) override {
+    return cpu_.RenderTo(view, film, targetCounts, counters, progress, cancel);
+  }
 
  private:
   CpuRenderer cpu_;
@@ -41,27 +45,45 @@ class CudaBackend : public Renderer {
   bool IsCuda() const override { return !fallback_; }
   bool Render(const Scene& scene, const SceneView& view, Film& film, int spp, TraceCounters* counters,
               const Progress& progress, const std::atomic<bool>* cancel) override {
-    if (fallback_) return fallback_->Render(scene, view, film, spp, counters, progress, cancel);
+    if (film.Adaptive()) {  // per-pixel counts: the same samples as RenderTo gives
+      std::vector<uint32_t> targets((size_t)film.Width() * film.Height());
+      for (size_t i = 0; i < targets.size(); ++i)
+        targets[i] = film.PixelSamples((int)(i % film.Width()), (int)(i / film.Width())) + (uint32_t)spp;
+      return RenderTo(scene, view, film, targets, counters, progress, cancel);
+    }
+    return Run(scene, view, [&] { gpu_.Render(film, spp, counters, progress); },
+               [&](Renderer& cpu) { return cpu.Render(scene, view, film, spp, counters, progress, cancel); });
+  }
+  bool RenderTo(const Scene& scene, const SceneView& view, Film& film, const std::vector<uint32_t>& targetCounts,
+                TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) override {
+    return Run(scene, view, [&] { gpu_.RenderTo(film, targetCounts, counters, progress); },
+               [&](Renderer& cpu) { return cpu.RenderTo(scene, view, film, targetCounts, counters, progress, cancel); });
+  }
+
+ private:
+  // Uploads the view (every call: the caller renders after a change; the
+  // voxels only the first time), refits, and runs `onDevice`; a scene too
+  // large for the device goes to `onCpu` with a CPU backend instead.
+  template <typename OnDevice, typename OnCpu>
+  bool Run(const Scene& scene, const SceneView& view, const OnDevice& onDevice, const OnCpu& onCpu) {
+    if (fallback_) return onCpu(*fallback_);
     try {
-      // Every call uploads the view (the caller renders after a change);
-      // the voxels only the first time.
       gpu_.SetScene(view, first_);
       const MajorantGrid* grid = scene.Grid();
       if (grid && view.majorants.kind != MajorantKind::Global &&
           scene.render.accelerator.grid.summary == SummaryMode::CellRanges)
         gpu_.Refit(*grid, view.classifier, first_);
       first_ = false;
-      gpu_.Render(film, spp, counters, progress);
+      onDevice();
       return true;
     } catch (const DeviceMemoryError& e) {
       if (fallbackThreads_ < 0) throw;
       if (note_) note_(std::string(e.what()) + "; rendering on the CPU instead");
       fallback_ = std::make_unique<CpuBackend>(fallbackThreads_);
-      return fallback_->Render(scene, view, film, spp, counters, progress, cancel);
+      return onCpu(*fallback_);
     }
   }
 
- private:
   GpuRenderer gpu_;
   int fallbackThreads_;
   std::function<void(const std::string&)> note_;

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "film.h"
 #include "mmrtm/counters.h"
@@ -50,6 +51,12 @@ class Renderer {
   virtual bool Render(const Scene& scene, const SceneView& view, Film& film, int samplesPerPixel,
                       TraceCounters* counters, const Progress& progress,
                       const std::atomic<bool>* cancel = nullptr) = 0;
+  // Adaptive sampling: adds samples to pixel i (row-major) until it has
+  // targetCounts[i]; sample indices continue from each pixel's own count.
+  // Afterwards the film has per-pixel counts (Film::Adaptive).
+  virtual bool RenderTo(const Scene& scene, const SceneView& view, Film& film,
+                        const std::vector<uint32_t>& targetCounts, TraceCounters* counters,
+                        const Progress& progress, const std::atomic<bool>* cancel = nullptr) = 0;
 };
 
 // `note` receives one-line remarks for the user (why auto chose the CPU, a

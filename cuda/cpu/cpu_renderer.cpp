@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -15,10 +17,33 @@ CpuRenderer::CpuRenderer(int threads)
 
 bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,
                          const Progress& progress, const std::atomic<bool>* cancel) const {
+  const auto end = [&](size_t, uint32_t first) { return first + (uint32_t)samplesPerPixel; };
+  if (!RenderRanges(scene, film, end, counters, progress, cancel)) return false;
+  film.AddSamples((uint32_t)samplesPerPixel);
+  return true;
+}
+
+bool CpuRenderer::RenderTo(const SceneView& scene, Film& film, const std::vector<uint32_t>& targetCounts,
+                           TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) const {
+  const size_t pixels = (size_t)film.Width() * film.Height();
+  if (targetCounts.size() != pixels)
+    throw std::invalid_argument("CpuRenderer::RenderTo: " + std::to_string(targetCounts.size()) +
+                                " sample counts for " + std::to_string(pixels) + " pixels");
+  const auto end = [&](size_t pixel, uint32_t first) { return std::max(first, targetCounts[pixel]); };
+  if (!RenderRanges(scene, film, end, counters, progress, cancel)) return false;
+  std::vector<uint32_t> counts(pixels);
+  for (size_t i = 0; i < pixels; ++i)
+    counts[i] = std::max(film.PixelSamples((int)(i % film.Width()), (int)(i / film.Width())), targetCounts[i]);
+  film.SetPixelSamples(std::move(counts));
+  return true;
+}
+
+bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film,
+                               const std::function<uint32_t(size_t, uint32_t)>& end, TraceCounters* counters,
+                               const Progress& progress, const std::atomic<bool>* cancel) const {
   const int width = film.Width(), height = film.Height();
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
   const int tileCount = tilesX * tilesY;
-  const uint32_t firstSample = film.Samples();
   FilmView view = film.View();
   SceneView s = scene;
   s.camera.width = width;
@@ -36,12 +61,15 @@ bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel
       const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
       const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
       for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x)
-          for (int i = 0; i < samplesPerPixel; ++i) {
-            const uint32_t index = firstSample + (uint32_t)i;
+        for (int x = x0; x < x1; ++x) {
+          const uint32_t first = film.PixelSamples(x, y), last = end((size_t)y * width + x, first);
+          const uint64_t workBefore = ctr.Work();
+          for (uint32_t index = first; index < last; ++index) {
             PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
             view.AddSample(x, y, ps.L, ps.alpha, index + 1);
           }
+          view.AddWork(x, y, (float)(ctr.Work() - workBefore));
+        }
       if (progress) {
         std::lock_guard<std::mutex> lock(progressMutex);
         progress(++tilesDone, tileCount);
@@ -55,7 +83,6 @@ bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel
   for (std::thread& t : pool) t.join();
 
   if (cancel && cancel->load()) return false;
-  film.AddSamples((uint32_t)samplesPerPixel);
   if (counters)
     for (const TraceCounters& c : perThread) *counters += c;
   return true;

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <functional>
+#include <vector>
 
 #include "film.h"
 #include "mmrtm/counters.h"
@@ -29,10 +30,21 @@ class CpuRenderer {
   // must be reset before it is used again.
   bool Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters = nullptr,
               const Progress& progress = nullptr, const std::atomic<bool>* cancel = nullptr) const;
+  // Adaptive sampling: adds samples to pixel i (row-major) until it has
+  // targetCounts[i] (none where it has that many already). Sample indices
+  // continue from each pixel's own count, so the image depends only on the
+  // counts, not on the passes or threads that produced them.
+  bool RenderTo(const SceneView& scene, Film& film, const std::vector<uint32_t>& targetCounts,
+                TraceCounters* counters = nullptr, const Progress& progress = nullptr,
+                const std::atomic<bool>* cancel = nullptr) const;
 
   static constexpr int kTileSize = 16;
 
  private:
+  // Renders sample indices [film.PixelSamples(x, y), end(pixel index)) of
+  // every pixel, over tiles; the caller updates the film's counts.
+  bool RenderRanges(const SceneView& scene, Film& film, const std::function<uint32_t(size_t, uint32_t)>& end,
+                    TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) const;
   int threads_;
 };
 

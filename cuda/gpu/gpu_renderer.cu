@@ -3,6 +3,8 @@
 // cuda/include/mmrtm, proven on the CPU.
 #include "gpu_renderer.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <map>
 #include <utility>
 
@@ -17,14 +19,19 @@ namespace {
 
 constexpr int kBlockX = 16, kBlockY = 8;
 
-// One sample of every pixel; the counters are summed per thread, then added
-// once.
-__global__ void RenderSampleKernel(SceneView scene, FilmView film, uint32_t index, TraceCounters* counters) {
+// Sample `index` of every pixel, or with per-pixel ranges (adaptive
+// sampling) of the pixels whose range [first, end) holds it; the counters
+// are summed per thread, then added once.
+__global__ void RenderSampleKernel(SceneView scene, FilmView film, uint32_t index, const uint32_t* first,
+                                   const uint32_t* end, TraceCounters* counters) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= film.width || y >= film.height) return;
+  const int64_t pixel = x + (int64_t)film.width * y;
+  if (first && (index < first[pixel] || index >= end[pixel])) return;
   TraceCounters ctr;
   const PixelSample ps = RenderPixelSample(scene, x, y, index, ctr);
   film.AddSample(x, y, ps.L, ps.alpha, index + 1);
+  film.AddWork(x, y, (float)ctr.Work());
   auto add = [](uint64_t* total, uint64_t v) {
     if (v) atomicAdd(reinterpret_cast<unsigned long long*>(total), (unsigned long long)v);
   };
@@ -63,9 +70,38 @@ struct GpuRenderer::Impl {
   float* majorants = nullptr;        // inside `tables`
   size_t majorantCount = 0;
   DeviceBuffer summaries[kMaxProxies], binMax, binMaterials;
-  DeviceBuffer filmMean, filmM2, counters;
+  DeviceBuffer filmMean, filmM2, filmWork, counters, rangeFirst, rangeEnd;
   int filmWidth = 0, filmHeight = 0;
   uint32_t filmSamples = 0;
+  bool filmUniform = true;  // false after RenderTo: the next Render uploads the film
+  bool hasWork = false;     // the device film has per-pixel work (Film::TrackWork)
+
+  // Puts the host film on the device (mean, M2, and work when tracked).
+  void UploadFilm(const FilmView& host) {
+    const size_t pixels = (size_t)host.width * host.height;
+    filmMean.Allocate(pixels * 4 * sizeof(float), "the film");
+    filmM2.Allocate(pixels * 3 * sizeof(float), "the film");
+    filmMean.Upload(host.mean, pixels * 4 * sizeof(float));
+    filmM2.Upload(host.m2, pixels * 3 * sizeof(float));
+    filmWork = DeviceBuffer();
+    if (host.work) {
+      filmWork.Allocate(pixels * sizeof(float), "the film");
+      filmWork.Upload(host.work, pixels * sizeof(float));
+    }
+    hasWork = host.work != nullptr;
+    filmWidth = host.width;
+    filmHeight = host.height;
+  }
+  FilmView DeviceFilm() {
+    return FilmView{filmWidth, filmHeight, filmMean.As<float>(), filmM2.As<float>(),
+                    hasWork ? filmWork.As<float>() : nullptr};
+  }
+  void DownloadFilm(const FilmView& host) const {
+    const size_t pixels = (size_t)host.width * host.height;
+    filmMean.Download(host.mean, pixels * 4 * sizeof(float));
+    filmM2.Download(host.m2, pixels * 3 * sizeof(float));
+    if (host.work) filmWork.Download(host.work, pixels * sizeof(float));
+  }
 };
 
 GpuRenderer::GpuRenderer() : impl_(new Impl) {
@@ -174,20 +210,17 @@ void GpuRenderer::Render(Film& film, int samplesPerPixel, TraceCounters* counter
   Impl& m = *impl_;
   if (!m.hasScene) throw CudaError("GpuRenderer::Render: no scene uploaded (SetScene)");
   const int width = film.Width(), height = film.Height();
-  const size_t pixels = (size_t)width * height;
-  FilmView host = film.View();
+  const FilmView host = film.View();
   // The device accumulation continues the host film's: after a reset or a
   // resize (or the first time) the host's state goes up.
-  if (width != m.filmWidth || height != m.filmHeight || film.Samples() != m.filmSamples) {
-    m.filmMean.Allocate(pixels * 4 * sizeof(float), "the film");
-    m.filmM2.Allocate(pixels * 3 * sizeof(float), "the film");
-    m.filmMean.Upload(host.mean, pixels * 4 * sizeof(float));
-    m.filmM2.Upload(host.m2, pixels * 3 * sizeof(float));
-    m.filmWidth = width;
-    m.filmHeight = height;
+  if (film.Adaptive()) throw CudaError("GpuRenderer::Render: the film has per-pixel counts (use RenderTo)");
+  if (width != m.filmWidth || height != m.filmHeight || film.Samples() != m.filmSamples || !m.filmUniform ||
+      (host.work != nullptr) != m.hasWork) {
+    m.UploadFilm(host);
     m.filmSamples = film.Samples();
+    m.filmUniform = true;
   }
-  FilmView device{width, height, m.filmMean.As<float>(), m.filmM2.As<float>()};
+  const FilmView device = m.DeviceFilm();
   SceneView scene = m.device;
   scene.camera.width = width;
   scene.camera.height = height;
@@ -196,7 +229,8 @@ void GpuRenderer::Render(Film& film, int samplesPerPixel, TraceCounters* counter
   const dim3 block(kBlockX, kBlockY), grid((width + kBlockX - 1) / kBlockX, (height + kBlockY - 1) / kBlockY);
   for (int i = 0; i < samplesPerPixel; ++i) {
     // One launch per sample: short kernels (no display watchdog), progress.
-    RenderSampleKernel<<<grid, block>>>(scene, device, m.filmSamples + (uint32_t)i, m.counters.As<TraceCounters>());
+    RenderSampleKernel<<<grid, block>>>(scene, device, m.filmSamples + (uint32_t)i, nullptr, nullptr,
+                                        m.counters.As<TraceCounters>());
     MMRTM_CUDA_CHECK(cudaGetLastError());
     if (progress) {
       MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
@@ -206,9 +240,59 @@ void GpuRenderer::Render(Film& film, int samplesPerPixel, TraceCounters* counter
   MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
   m.filmSamples += (uint32_t)samplesPerPixel;
 
-  m.filmMean.Download(host.mean, pixels * 4 * sizeof(float));
-  m.filmM2.Download(host.m2, pixels * 3 * sizeof(float));
+  m.DownloadFilm(host);
   film.AddSamples((uint32_t)samplesPerPixel);
+  if (counters) {
+    TraceCounters c;
+    m.counters.Download(&c, sizeof c);
+    *counters += c;
+  }
+}
+
+void GpuRenderer::RenderTo(Film& film, const std::vector<uint32_t>& targetCounts, TraceCounters* counters,
+                           const Progress& progress) {
+  Impl& m = *impl_;
+  if (!m.hasScene) throw CudaError("GpuRenderer::RenderTo: no scene uploaded (SetScene)");
+  const int width = film.Width(), height = film.Height();
+  const size_t pixels = (size_t)width * height;
+  if (targetCounts.size() != pixels) throw CudaError("GpuRenderer::RenderTo: one sample count per pixel expected");
+  std::vector<uint32_t> first(pixels), end(pixels);
+  uint32_t lowest = UINT32_MAX, highest = 0;
+  for (size_t i = 0; i < pixels; ++i) {
+    first[i] = film.PixelSamples((int)(i % width), (int)(i / width));
+    end[i] = std::max(first[i], targetCounts[i]);
+    if (end[i] > first[i]) {
+      lowest = std::min(lowest, first[i]);
+      highest = std::max(highest, end[i]);
+    }
+  }
+  // Per-pixel counts: the host film goes up every time (a few MB, once a pass).
+  const FilmView host = film.View();
+  m.UploadFilm(host);
+  m.filmUniform = false;
+  m.rangeFirst.Allocate(pixels * sizeof(uint32_t), "sample counts");
+  m.rangeEnd.Allocate(pixels * sizeof(uint32_t), "sample counts");
+  m.rangeFirst.Upload(first.data(), pixels * sizeof(uint32_t));
+  m.rangeEnd.Upload(end.data(), pixels * sizeof(uint32_t));
+  const FilmView device = m.DeviceFilm();
+  SceneView scene = m.device;
+  scene.camera.width = width;
+  scene.camera.height = height;
+  MMRTM_CUDA_CHECK(cudaMemset(m.counters.Get(), 0, sizeof(TraceCounters)));
+
+  const dim3 block(kBlockX, kBlockY), grid((width + kBlockX - 1) / kBlockX, (height + kBlockY - 1) / kBlockY);
+  for (uint32_t index = lowest; index < highest; ++index) {
+    RenderSampleKernel<<<grid, block>>>(scene, device, index, m.rangeFirst.As<uint32_t>(), m.rangeEnd.As<uint32_t>(),
+                                        m.counters.As<TraceCounters>());
+    MMRTM_CUDA_CHECK(cudaGetLastError());
+    if (progress) {
+      MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+      progress((int)(index - lowest + 1), (int)(highest - lowest));
+    }
+  }
+  MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+  m.DownloadFilm(host);
+  film.SetPixelSamples(std::move(end));
   if (counters) {
     TraceCounters c;
     m.counters.Download(&c, sizeof c);

@@ -49,6 +49,11 @@ class GpuRenderer {
   using Progress = std::function<void(int, int)>;
   void Render(Film& film, int samplesPerPixel, TraceCounters* counters = nullptr,
               const Progress& progress = nullptr);
+  // Adaptive sampling: adds samples to pixel i until it has targetCounts[i]
+  // (indices continue from each pixel's own count, as on the CPU). The film
+  // goes up and comes back on every call; `film` may be uniform or adaptive.
+  void RenderTo(Film& film, const std::vector<uint32_t>& targetCounts, TraceCounters* counters = nullptr,
+                const Progress& progress = nullptr);
 
  private:
   struct Impl;

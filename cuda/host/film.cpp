@@ -11,8 +11,34 @@ Film::Film(int width, int height) : width_(width), height_(height) { Reset(); }
 
 void Film::Reset() {
   samples_ = 0;
+  pixelSamples_.clear();
   mean_.assign((size_t)width_ * height_ * 4, 0.f);
   m2_.assign((size_t)width_ * height_ * 3, 0.f);
+  if (!work_.empty()) TrackWork();
+}
+
+void Film::AddSamples(uint32_t n) {
+  samples_ += n;
+  for (uint32_t& c : pixelSamples_) c += n;
+}
+
+void Film::SetPixelSamples(std::vector<uint32_t> counts) {
+  if (counts.size() != (size_t)width_ * height_)
+    throw std::invalid_argument("Film::SetPixelSamples: " + std::to_string(counts.size()) + " counts for " +
+                                std::to_string(width_) + " x " + std::to_string(height_) + " pixels");
+  samples_ = counts.empty() ? 0 : *std::min_element(counts.begin(), counts.end());
+  pixelSamples_ = std::move(counts);
+}
+
+double Film::MeanSamples() const {
+  if (!Adaptive()) return samples_;
+  double sum = 0;
+  for (uint32_t c : pixelSamples_) sum += c;
+  return sum / (double)pixelSamples_.size();
+}
+
+uint32_t Film::MaxSamples() const {
+  return Adaptive() ? *std::max_element(pixelSamples_.begin(), pixelSamples_.end()) : samples_;
 }
 
 RGB Film::Mean(int x, int y) const {
@@ -21,9 +47,10 @@ RGB Film::Mean(int x, int y) const {
 }
 
 RGB Film::VarianceOfMean(int x, int y) const {
-  if (samples_ < 2) return RGB(0.f);
+  const uint32_t n = PixelSamples(x, y);
+  if (n < 2) return RGB(0.f);
   const float* s = &m2_[3 * ((size_t)y * width_ + x)];
-  const float norm = 1.f / ((float)samples_ * (float)(samples_ - 1));
+  const float norm = 1.f / ((float)n * (float)(n - 1));
   return RGB(s[0] * norm, s[1] * norm, s[2] * norm);
 }
 
@@ -55,6 +82,7 @@ NoiseEstimate Film::Noise() const {
 }
 
 std::vector<double> Film::Moments() const {
+  if (Adaptive()) throw std::logic_error("Film::Moments: an adaptively sampled film has per-pixel counts");
   const size_t pixels = (size_t)width_ * height_;
   std::vector<double> out(pixels * kMomentsPerPixel);
   const double n = samples_;

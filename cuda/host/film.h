@@ -31,12 +31,35 @@ class Film {
  public:
   Film(int width, int height);
 
-  FilmView View() { return FilmView{width_, height_, mean_.data(), m2_.data()}; }
+  FilmView View() {
+    return FilmView{width_, height_, mean_.data(), m2_.data(), work_.empty() ? nullptr : work_.data()};
+  }
   void Reset();
   int Width() const { return width_; }
   int Height() const { return height_; }
+  // Samples that every pixel has: all of them in a uniformly sampled film,
+  // the fewest of any pixel after adaptive sampling (SetPixelSamples).
   uint32_t Samples() const { return samples_; }
-  void AddSamples(uint32_t n) { samples_ += n; }
+  // Adds n samples to every pixel's count (a uniform pass).
+  void AddSamples(uint32_t n);
+
+  // Adaptive sampling: pixels with their own sample counts. A film is
+  // uniform until SetPixelSamples; Reset makes it uniform again.
+  bool Adaptive() const { return !pixelSamples_.empty(); }
+  uint32_t PixelSamples(int x, int y) const {
+    return Adaptive() ? pixelSamples_[(size_t)y * width_ + x] : samples_;
+  }
+  double MeanSamples() const;
+  uint32_t MaxSamples() const;
+  // Records the per-pixel counts after a pass that brought pixel i to
+  // counts[i] samples (row-major, width x height values).
+  void SetPixelSamples(std::vector<uint32_t> counts);
+
+  // Per-pixel work (TraceCounters::Work of the pixel's samples), kept when
+  // enabled: adaptive sampling weighs a pixel's noise by its cost.
+  void TrackWork() { work_.assign((size_t)width_ * height_, 0.f); }
+  bool TracksWork() const { return !work_.empty(); }
+  float Work(int x, int y) const { return work_.empty() ? 0.f : work_[(size_t)y * width_ + x]; }
 
   RGB Mean(int x, int y) const;
   float Alpha(int x, int y) const { return mean_[4 * ((size_t)y * width_ + x) + 3]; }
@@ -55,7 +78,8 @@ class Film {
   // their samples had been added to it, by summing their moments. Per
   // pixel, kMomentsPerPixel doubles: n mean (RGBA) and M2 + n mean^2 (RGB),
   // with n the film's samples. Sums in double: exact enough for the
-  // variance of thousands of samples.
+  // variance of thousands of samples. Uniform films only: an adaptive
+  // film's moments would need its counts (std::logic_error).
   static constexpr int kMomentsPerPixel = 7;
   std::vector<double> Moments() const;
   // The film whose samples are `samples` in all, from the element-wise sum
@@ -65,7 +89,8 @@ class Film {
  private:
   int width_, height_;
   uint32_t samples_ = 0;
-  std::vector<float> mean_, m2_;
+  std::vector<uint32_t> pixelSamples_;  // empty: every pixel has samples_
+  std::vector<float> mean_, m2_, work_;
 };
 
 }  // namespace mmrtm

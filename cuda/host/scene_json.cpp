@@ -539,7 +539,7 @@ class Parser {
       CheckKeys(rj, w,
                 {"width", "height", "spp", "seed", "threads", "estimator", "max_bounces", "russian_roulette_depth",
                  "shadow_extinction_scale", "ray_march_step", "exposure", "tone_mapper", "background", "accelerator",
-                 "leaf_level"});
+                 "leaf_level", "light_sampling"});
       r.width = IntegerOr(rj, "width", r.width, w);
       r.height = IntegerOr(rj, "height", r.height, w);
       r.samplesPerPixel = IntegerOr(rj, "spp", r.samplesPerPixel, w);
@@ -557,6 +557,10 @@ class Parser {
           NumberOr(rj, "shadow_extinction_scale", r.integrator.shadowExtinctionScale, w);
       r.integrator.rayMarchStep = NumberOr(rj, "ray_march_step", r.integrator.rayMarchStep, w);
       r.integrator.backgroundVisible = BoolOr(rj, "background", r.integrator.backgroundVisible, w);
+      const std::string lights = StringOr(rj, "light_sampling", LightSamplingName(r.integrator.lightSampling), w);
+      const std::optional<LightSampling> lightSampling = ParseLightSampling(lights);
+      if (!lightSampling) Fail(w + ".light_sampling", "expected one, all or resampled, got '" + lights + "'");
+      r.integrator.lightSampling = *lightSampling;
       const std::string acc = StringOr(rj, "accelerator", "octree", w);
       AcceleratorSettings& a = r.accelerator;
       if (acc == "none") a.kind = MajorantKind::Global;
@@ -644,6 +648,22 @@ std::string PresetPath(const std::string& presetDirectory, const std::string& na
     for (const auto& e : fs::directory_iterator(presetDirectory))
       if (e.path().extension() == ".json") list += (list.empty() ? "" : ", ") + e.path().stem().string();
   throw InputError("no preset named '" + name + "' (presets: " + (list.empty() ? "none found" : list) + ")");
+}
+
+std::optional<LightSampling> ParseLightSampling(const std::string& name) {
+  if (name == "one") return LightSampling::One;
+  if (name == "all") return LightSampling::All;
+  if (name == "resampled") return LightSampling::Resampled;
+  return std::nullopt;
+}
+
+const char* LightSamplingName(LightSampling mode) {
+  switch (mode) {
+    case LightSampling::One: return "one";
+    case LightSampling::All: return "all";
+    case LightSampling::Resampled: return "resampled";
+  }
+  return "one";
 }
 
 }  // namespace mmrtm

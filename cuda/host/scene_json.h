@@ -51,4 +51,9 @@ Scene SceneFromJson(const nlohmann::json& doc, SceneInputs inputs);
 // throws InputError listing the presets there if it does not exist.
 std::string PresetPath(const std::string& presetDirectory, const std::string& name);
 
+// The scene file's names of the next-event estimation modes ("one", "all",
+// "resampled"); nullopt for another name.
+std::optional<LightSampling> ParseLightSampling(const std::string& name);
+const char* LightSamplingName(LightSampling mode);
+
 }  // namespace mmrtm

@@ -15,6 +15,11 @@ struct TraceCounters {
   uint64_t majorantSegments = 0;    // segments handed out by majorant iterators
   uint64_t majorantViolations = 0;  // lookups whose sigma_t exceeded the majorant (must stay 0)
 
+  // A deterministic measure of the time spent, for adaptive sampling's cost
+  // per pixel: the lookups and segments dominate a sample's time; one unit
+  // per path stands for the camera ray and the film.
+  MMRTM_CPU_GPU uint64_t Work() const { return densityLookups + majorantSegments + paths; }
+
   MMRTM_CPU_GPU TraceCounters& operator+=(const TraceCounters& o) {
     paths += o.paths;
     densityLookups += o.densityLookups;

@@ -13,6 +13,7 @@ struct FilmView {
   int width = 0, height = 0;
   float* mean = nullptr;  // 4 floats a pixel: RGB radiance and alpha (coverage)
   float* m2 = nullptr;    // 3 floats a pixel: sum of squared deviations of RGB
+  float* work = nullptr;  // optional, 1 float a pixel: TraceCounters::Work of its samples
 
   // Adds sample number n (1-based) of pixel (x, y).
   MMRTM_CPU_GPU void AddSample(int x, int y, RGB L, float alpha, uint32_t n) const {
@@ -26,6 +27,9 @@ struct FilmView {
       s[c] += delta * (L[c] - m[c]);
     }
     m[3] += (alpha - m[3]) * inv;
+  }
+  MMRTM_CPU_GPU void AddWork(int x, int y, float units) const {
+    if (work) work[x + (int64_t)width * y] += units;
   }
 };
 

@@ -35,7 +35,15 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
   PixelSample out;
   RGB beta(1.f);
   float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
-  float lightSelectPdf = s.lightCount > 0 ? 1.f / (float)s.lightCount : 0.f;
+  // With one light every mode is the same estimator: One's code (and its
+  // random numbers, so images of one-light scenes do not depend on the mode).
+  const LightSampling lightSampling = s.lightCount == 1 ? LightSampling::One : s.settings.lightSampling;
+  // The probability that NEE samples a given light, for the MIS weights:
+  // 1/K when it picks one of K uniformly; 1 when it estimates the sum over
+  // all lights (All, and Resampled, which estimates that same sum).
+  float lightSelectPdf = s.lightCount <= 0 ? 0.f
+                         : lightSampling == LightSampling::One ? 1.f / (float)s.lightCount
+                                                               : 1.f;
   for (int depth = 0;; ++depth) {
     FreePathResult fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr);
     if (!fp.collided) {
@@ -72,18 +80,57 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     HGPhaseFunction phase{k.g};
     if (!surface) beta *= k.albedo;
 
-    // Next-event estimation with one light chosen uniformly.
+    // Next-event estimation (IntegratorSettings::lightSampling).
     if (s.lightCount > 0) {
-      int li = ClampInt((int)(rng.Uniform() * s.lightCount), 0, s.lightCount - 1);
-      float u0 = rng.Uniform(), u1 = rng.Uniform();
-      LightSample ls = SampleLight(s.lights[li], s.environment, p, u0, u1);
-      if (ls.pdf > 0.f && !ls.L.IsBlack()) {
+      // A light's unshadowed contribution for a direction sampled on it;
+      // false when it has none.
+      LightSample ls;
+      auto unshadowed = [&](int li, RGB* c) {
+        float u0 = rng.Uniform(), u1 = rng.Uniform();
+        ls = SampleLight(s.lights[li], s.environment, p, u0, u1);
+        if (ls.pdf <= 0.f || ls.L.IsBlack()) return false;
         RGB f = surface ? bsdf.Eval(wo, ls.wi) : RGB(phase.p(wo, ls.wi));
-        if (!f.IsBlack()) {
-          float T = Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr);
-          float lightPdf = lightSelectPdf * ls.pdf;
-          float w = ls.isDelta ? 1.f : PowerHeuristic(lightPdf, surface ? bsdf.Pdf(wo, ls.wi) : phase.Pdf(wo, ls.wi));
-          out.L += beta * f * ls.L * (T * w / lightPdf);
+        if (f.IsBlack()) return false;
+        float lightPdf = lightSelectPdf * ls.pdf;
+        float w = ls.isDelta ? 1.f : PowerHeuristic(lightPdf, surface ? bsdf.Pdf(wo, ls.wi) : phase.Pdf(wo, ls.wi));
+        *c = beta * f * ls.L * (w / lightPdf);
+        return true;
+      };
+      RGB c;
+      switch (lightSampling) {
+        case LightSampling::One: {
+          int li = ClampInt((int)(rng.Uniform() * s.lightCount), 0, s.lightCount - 1);
+          if (unshadowed(li, &c)) out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr);
+          break;
+        }
+        case LightSampling::All:
+          for (int li = 0; li < s.lightCount; ++li)
+            if (unshadowed(li, &c)) out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr);
+          break;
+        case LightSampling::Resampled: {
+          // One candidate per light, one kept with probability in
+          // proportion to its unshadowed luminance (a one-sample reservoir
+          // over the lights), one shadow ray: c T / P(kept) estimates the
+          // sum over all lights, and where no shadow falls it is that sum
+          // exactly, whichever light was kept.
+          RGB kept;
+          Vec3 keptDir;
+          float keptDistance = 0.f, keptWeight = 0.f, weightSum = 0.f;
+          for (int li = 0; li < s.lightCount; ++li) {
+            if (!unshadowed(li, &c)) continue;
+            const float weight = Luminance(c);
+            if (!(weight > 0.f)) continue;
+            weightSum += weight;
+            if (rng.Uniform() * weightSum < weight) {
+              kept = c;
+              keptDir = ls.wi;
+              keptDistance = ls.distance;
+              keptWeight = weight;
+            }
+          }
+          if (keptWeight > 0.f)
+            out.L += kept * (Transmittance(s, Ray{p, keptDir}, keptDistance, rng, ctr) * weightSum / keptWeight);
+          break;
         }
       }
     }

@@ -19,6 +19,13 @@ enum class Estimator : uint8_t {
 // 1 is the unbiased estimator (DESIGN.md rule 5).
 constexpr float kDefaultShadowExtinctionScale = 0.8f;
 
+// Next-event estimation with several lights.
+enum class LightSampling {
+  One,       // one light chosen uniformly, one shadow ray
+  All,       // a shadow ray to every light
+  Resampled  // one light chosen by its unshadowed contribution, one shadow ray
+};
+
 struct IntegratorSettings {
   Estimator estimator = Estimator::DeltaTracking;
   int maxBounces = 32;         // real scattering events per path
@@ -26,6 +33,7 @@ struct IntegratorSettings {
   float shadowExtinctionScale = kDefaultShadowExtinctionScale;
   float rayMarchStep = 0.5f;   // ray marching step, world units
   bool backgroundVisible = true;  // camera rays that escape see the environment
+  LightSampling lightSampling = LightSampling::Resampled;
   uint64_t seed = 0;
 };
 
