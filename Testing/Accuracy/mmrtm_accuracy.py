@@ -110,17 +110,19 @@ class Render:
         return self.stats["seconds"]["render"]
 
 
-def render(args, width, height, spp, seed=0, extra=(), keep=None):
+def render(args, width, height, spp, seed=0, extra=(), keep=None, binary=None):
     """Runs mmrtm-render with `args` (input and scene options) and returns a Render.
 
     `keep`, a path prefix, also keeps PREFIX.pfm, PREFIX_variance.pfm,
     PREFIX.png and PREFIX.json; otherwise everything goes to a temporary folder.
+    `binary`: another mmrtm-render (an older build, to compare with).
     """
-    if not RENDER.exists():
-        sys.exit(f"{RENDER}: not built (cmake --build build)")
+    binary = Path(binary) if binary else RENDER
+    if not binary.exists():
+        sys.exit(f"{binary}: not built (cmake --build build)")
     with tempfile.TemporaryDirectory() as tmp:
         prefix = Path(keep) if keep else Path(tmp) / "render"
-        cmd = [str(RENDER), *map(str, args), "--width", str(width), "--height", str(height),
+        cmd = [str(binary), *map(str, args), "--width", str(width), "--height", str(height),
                "--spp", str(spp), "--seed", str(seed), "--quiet",
                "--output", f"{prefix}.png", "--output-linear", f"{prefix}.pfm",
                "--output-variance", f"{prefix}_variance.pfm", "--stats-json", f"{prefix}.json", *map(str, extra)]
@@ -166,13 +168,16 @@ def block_agreement(mean_a, var_a, mean_b, var_b, block=4):
     pixel). For agreeing images the mean of z^2 over K blocks and channels is
     1 with standard deviation sqrt(2 / K); `limit` is 1 + 5 sqrt(2 / K), a
     one-in-a-million tail, which a bias of a fraction of the noise exceeds.
-    Blocks without noise (float rounding leaves ~1e-15 there, e.g. where only
-    the constant environment is seen) must agree to float precision.
+    Blocks without noise (float rounding leaves ~1e-17 there, e.g. where only
+    the constant environment is seen) must agree to float precision. A block
+    counts as noiseless only below (1e-7 of its value)^2: a block that one
+    rare collision makes noisy (a variance of ~1e-11 at the medium's edge,
+    seen at 128 x 128 and 2048 spp) is z-tested, not held to 1e-5.
     """
     n = block * block
     a, b = block_sums(mean_a, block) / n, block_sums(mean_b, block) / n
     var = (block_sums(var_a, block) + block_sums(var_b, block)) / n ** 2
-    noisy = var > (1e-5 * (np.abs(b) + 1e-3)) ** 2
+    noisy = var > (1e-7 * (np.abs(b) + 1e-3)) ** 2
     silent_mismatch = int(np.sum(~noisy & (np.abs(a - b) > 1e-5 * np.abs(b) + 1e-7)))
     z2 = (a - b)[noisy] ** 2 / var[noisy]
     k = int(z2.size)

@@ -26,12 +26,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import mmrtm_accuracy as acc  # noqa: E402
 
 SEED = 7  # differs from make_references.REFERENCE_SEED: independent noise
+BEFORE = "delta, octree, one light chosen (before)"
 
 METHODS = [
     # label, options, colour, line style
     ("delta, no accelerator", ["--accelerator", "none"], "tab:gray", "-"),
     ("delta, macrocell", ["--accelerator", "macrocell"], "tab:blue", "-"),
     ("delta, octree (default)", ["--accelerator", "octree"], "tab:green", "-"),
+    # Before issue 15's changes to next-event estimation: one light chosen uniformly.
+    (BEFORE, ["--accelerator", "octree", "--light-sampling", "one"], "black", "-."),
+    ("delta, octree, adaptive sampling", ["--accelerator", "octree", "--sampling", "adaptive"], "tab:cyan", "-"),
     ("delta, octree-voxelmax", ["--accelerator", "octree-voxelmax"], "tab:olive", "--"),
     ("ray marching 2 mm", ["--estimator", "raymarch", "--ray-march-step", "2"], "tab:red", ":"),
     ("ray marching 1 mm", ["--estimator", "raymarch", "--ray-march-step", "1"], "tab:orange", ":"),
@@ -107,27 +111,29 @@ def chart(name, result, path):
 
 def table(results):
     """Markdown: per scene and method, the last measured rung, and the time each
-    method needs to reach the default's error at its last rung (t e^2 / e0^2,
-    valid while the error is still falling as 1 / sqrt(samples); a method
-    whose error has stopped falling above that error never reaches it)."""
-    lines = ["| scene | method | spp | render s | rel. RMSE | rel. bias | time to the octree's error |",
-             "|---|---|---|---|---|---|---|"]
+    method needs to reach the error of the renderer before issue 15 (one light
+    chosen uniformly, octree) at its last rung (64 spp): t e^2 / e0^2, valid
+    while the error is still falling as 1 / sqrt(samples); a method whose
+    error has stopped falling above that error never reaches it."""
+    lines = ["| scene | method | spp | render s | rel. RMSE | rel. bias | time to before's error | speed-up |",
+             "|---|---|---|---|---|---|---|---|"]
     for name, result in results.items():
-        target = result["methods"]["delta, octree (default)"][-1]
+        target = result["methods"].get(BEFORE, result["methods"]["delta, octree (default)"])[-1]
         for label, _, _, _ in METHODS:
             rows = result["methods"].get(label)
             if not rows:
                 continue
             last = rows[-1]
             falling = len(rows) < 2 or last["rel_rmse"] < 0.85 * rows[-2]["rel_rmse"]
+            seconds = last["seconds"] * (last["rel_rmse"] / target["rel_rmse"]) ** 2
             if last["rel_rmse"] <= target["rel_rmse"]:
-                reach = f"{last['seconds'] * (last['rel_rmse'] / target['rel_rmse']) ** 2:.1f} s"
+                reach, speedup = f"{seconds:.1f} s", f"{target['seconds'] / seconds:.2f}"
             elif falling:
-                reach = f"~{last['seconds'] * (last['rel_rmse'] / target['rel_rmse']) ** 2:.0f} s"
+                reach, speedup = f"~{seconds:.0f} s", f"~{target['seconds'] / seconds:.2f}"
             else:
-                reach = "never (bias)"
+                reach, speedup = "never (bias)", ""
             lines.append(f"| {acc.SCENES[name]['title']} | {label} | {last['spp']} | {last['seconds']:.1f} | "
-                         f"{last['rel_rmse']:.4f} | {last['rel_bias']:.4f} | {reach} |")
+                         f"{last['rel_rmse']:.4f} | {last['rel_bias']:.4f} | {reach} | {speedup} |")
     return "\n".join(lines)
 
 

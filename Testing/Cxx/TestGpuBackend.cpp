@@ -32,6 +32,20 @@ Scene HeadScene(uint64_t seed) {
   return SceneFromJson(doc, std::move(inputs));
 }
 
+// Pixels whose colours agree to float tolerance (device and host maths round
+// differently).
+int ClosePixels(const Film& a, const Film& b) {
+  int close = 0;
+  for (int y = 0; y < a.Height(); ++y)
+    for (int x = 0; x < a.Width(); ++x) {
+      const RGB p = a.Mean(x, y), q = b.Mean(x, y);
+      bool ok = true;
+      for (int c = 0; c < 3; ++c) ok = ok && std::fabs(p[c] - q[c]) <= 1e-4f + 1e-3f * std::fabs(p[c]);
+      close += ok;
+    }
+  return close;
+}
+
 TEST(GpuBackend, RefitEqualsTheCpuRefitExactly) {
   SKIP_WITHOUT_DEVICE();
   Scene scene = HeadScene(1);
@@ -63,15 +77,7 @@ TEST(GpuBackend, ImageMatchesTheCpuImageOfTheSameSeed) {
   GpuRenderer renderer;
   renderer.SetScene(view, true);
   renderer.Render(gpu, 16, &gpuCounters);
-  int close = 0;
-  for (int y = 0; y < 96; ++y)
-    for (int x = 0; x < 96; ++x) {
-      const RGB a = cpu.Mean(x, y), b = gpu.Mean(x, y);
-      bool ok = true;
-      for (int c = 0; c < 3; ++c) ok = ok && std::fabs(a[c] - b[c]) <= 1e-4f + 1e-3f * std::fabs(a[c]);
-      close += ok;
-    }
-  EXPECT_GE(close, 96 * 96 * 99 / 100) << "pixels equal to float tolerance";
+  EXPECT_GE(ClosePixels(cpu, gpu), 96 * 96 * 99 / 100) << "pixels equal to float tolerance";
   EXPECT_LT(MeanSquaredZScore(cpu, gpu), 0.1);
   EXPECT_EQ(gpuCounters.paths, cpuCounters.paths);
   EXPECT_EQ(gpuCounters.majorantViolations, 0u);
@@ -95,6 +101,38 @@ TEST(GpuBackend, AccumulationContinuesOnTheDevice) {
   for (size_t i = 0; i < a.pixels.size(); ++i)
     for (int c = 0; c < 3; ++c) differ += a.pixels[i][c] != b.pixels[i][c];
   EXPECT_EQ(differ, 0);
+}
+
+// Adaptive sampling on the device: per-pixel counts give the CPU's image
+// (the same sample indices per pixel), and the per-pixel work comes back.
+TEST(GpuBackend, PerPixelCountsMatchTheCpu) {
+  SKIP_WITHOUT_DEVICE();
+  Scene scene = HeadScene(5);
+  const SceneView view = scene.Build();
+  std::vector<uint32_t> counts(64 * 64);
+  for (size_t i = 0; i < counts.size(); ++i) counts[i] = 4 + (uint32_t)(i * 7 % 13);
+  Film cpu(64, 64), gpu(64, 64);
+  cpu.TrackWork();
+  gpu.TrackWork();
+  TraceCounters cpuCounters, gpuCounters;
+  CpuRenderer(0).Render(view, cpu, 4, &cpuCounters);
+  CpuRenderer(0).RenderTo(view, cpu, counts, &cpuCounters);
+  GpuRenderer renderer;
+  renderer.SetScene(view, true);
+  renderer.Render(gpu, 4, &gpuCounters);
+  renderer.RenderTo(gpu, counts, &gpuCounters);
+  ASSERT_TRUE(gpu.Adaptive());
+  EXPECT_EQ(gpu.PixelSamples(10, 20), counts[20 * 64 + 10]);
+  EXPECT_EQ(gpuCounters.paths, cpuCounters.paths);
+  double workCpu = 0, workGpu = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      workCpu += cpu.Work(x, y);
+      workGpu += gpu.Work(x, y);
+    }
+  EXPECT_GE(ClosePixels(cpu, gpu), 64 * 64 * 99 / 100) << "pixels equal to float tolerance";
+  EXPECT_GT(workCpu, 0.0);
+  EXPECT_NEAR(workGpu, workCpu, 0.01 * workCpu);
 }
 
 }  // namespace

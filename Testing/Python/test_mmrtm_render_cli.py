@@ -180,6 +180,41 @@ class RenderCli(unittest.TestCase):
         self.expect_failure(self.run_render(HEADSQ, "--noise-target", "0"), "--noise-target", code=2)
         self.expect_failure(self.run_render(HEADSQ, "--noise-target", "two"), "--noise-target", code=2)
 
+    def test_adaptive_sampling(self):
+        # A mean of 16 spp split by the pilot's noise: the counts differ from
+        # pixel to pixel, never below the pilot's (16 / 8 = 2), and the mean
+        # is what was asked for.
+        adaptive, pixels = self.render_linear("adaptive", "--spp", "16", "--sampling", "adaptive")
+        self.assertEqual(adaptive["sampling"], "adaptive")
+        self.assertAlmostEqual(adaptive["spp"], 16, delta=0.2)
+        self.assertEqual(adaptive["spp_min"], 2)
+        self.assertGreater(adaptive["spp_max"], 32)
+        self.assertAlmostEqual(adaptive["paths"], 40 * 30 * adaptive["spp"], delta=1)
+        again, same = self.render_linear("again", "--spp", "16", "--sampling", "adaptive", "--threads", "1")
+        self.assertEqual(same, pixels, "the same image at any thread count")
+        uniform, _ = self.render_linear("uniform", "--spp", "16", "--sampling", "uniform")
+        self.assertEqual((uniform["sampling"], uniform["spp"], uniform["spp_min"], uniform["spp_max"]),
+                         ("uniform", 16, 16, 16))
+        # With a target: passes of the pilot's split until the noise is met.
+        stopped, _ = self.render_linear("stopped", "--spp", "4096", "--noise-target", "0.1", "--sampling", "adaptive")
+        self.assertEqual(stopped["stopped_on"], "noise_target")
+        self.assertLessEqual(stopped["noise"]["relative"], 0.1)
+        os.remove(self.png)
+        self.expect_failure(self.run_render(HEADSQ, "--sampling", "smart"), "--sampling", code=2)
+
+    def test_light_sampling(self):
+        stats = {}
+        for mode in ("one", "all", "resampled"):
+            stats[mode], _ = self.render_linear(mode, "--spp", "8", "--light-sampling", mode)
+        # The preset has a sky and a sun: every event sends one shadow ray at
+        # most, except with all, which sends one to each.
+        self.assertGreater(stats["all"]["shadow_rays"], 1.5 * stats["one"]["shadow_rays"])
+        self.assertLessEqual(stats["resampled"]["shadow_rays"], stats["resampled"]["real_collisions"])
+        os.remove(self.png)
+        self.expect_failure(self.run_render(HEADSQ, "--light-sampling", "some"), "--light-sampling", code=2)
+        scene = self.write("scene.json", json.dumps({"render": {"light_sampling": "every"}}))
+        self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-bone", "--scene", scene), "render.light_sampling", "every")
+
     def test_degenerate_volumes(self):
         # One voxel, a 1 x 1 x 1000 line, a single slice: nothing to render,
         # said clearly instead of an empty image (or a camera error).
@@ -256,7 +291,8 @@ class RenderCli(unittest.TestCase):
         r = subprocess.run([RENDER, "--help"], capture_output=True, text=True, timeout=60)
         self.assertEqual(r.returncode, 0)
         for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--backend", "--width", "--height", "--spp", "--seed", "--threads",
-                       "--estimator", "--output", "--output-linear", "--stats-json", "--noise-target"]:
+                       "--estimator", "--output", "--output-linear", "--stats-json", "--noise-target", "--sampling",
+                       "--light-sampling"]:
             self.assertIn(option, r.stdout)
 
 

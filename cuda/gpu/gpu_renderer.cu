@@ -101,7 +101,35 @@ struct GpuRenderer::Impl {
     filmMean.Download(host.mean, pixels * 4 * sizeof(float));
     filmM2.Download(host.m2, pixels * 3 * sizeof(float));
     if (host.work) filmWork.Download(host.work, pixels * sizeof(float));
+  }  // Renders sample indices [from, to) of every pixel, or with per-pixel
+  // ranges [first, end) of the pixels whose range holds them; one launch
+  // per index: short kernels (no display watchdog), progress. Returns the
+  // pass's counters through `out` (when given).
+  void LaunchSamples(uint32_t from, uint32_t to, const uint32_t* first, const uint32_t* end,
+                     const GpuRenderer::Progress& progress, TraceCounters* out) {
+    SceneView scene = device;
+    scene.camera.width = filmWidth;
+    scene.camera.height = filmHeight;
+    const FilmView film = DeviceFilm();
+    MMRTM_CUDA_CHECK(cudaMemset(counters.Get(), 0, sizeof(TraceCounters)));
+    const dim3 block(kBlockX, kBlockY),
+        grid((filmWidth + kBlockX - 1) / kBlockX, (filmHeight + kBlockY - 1) / kBlockY);
+    for (uint32_t index = from; index < to; ++index) {
+      RenderSampleKernel<<<grid, block>>>(scene, film, index, first, end, counters.As<TraceCounters>());
+      MMRTM_CUDA_CHECK(cudaGetLastError());
+      if (progress) {
+        MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+        progress((int)(index - from + 1), (int)(to - from));
+      }
+    }
+    MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+    if (out) {
+      TraceCounters c;
+      counters.Download(&c, sizeof c);
+      *out += c;
+    }
   }
+
 };
 
 GpuRenderer::GpuRenderer() : impl_(new Impl) {
@@ -220,33 +248,10 @@ void GpuRenderer::Render(Film& film, int samplesPerPixel, TraceCounters* counter
     m.filmSamples = film.Samples();
     m.filmUniform = true;
   }
-  const FilmView device = m.DeviceFilm();
-  SceneView scene = m.device;
-  scene.camera.width = width;
-  scene.camera.height = height;
-  MMRTM_CUDA_CHECK(cudaMemset(m.counters.Get(), 0, sizeof(TraceCounters)));
-
-  const dim3 block(kBlockX, kBlockY), grid((width + kBlockX - 1) / kBlockX, (height + kBlockY - 1) / kBlockY);
-  for (int i = 0; i < samplesPerPixel; ++i) {
-    // One launch per sample: short kernels (no display watchdog), progress.
-    RenderSampleKernel<<<grid, block>>>(scene, device, m.filmSamples + (uint32_t)i, nullptr, nullptr,
-                                        m.counters.As<TraceCounters>());
-    MMRTM_CUDA_CHECK(cudaGetLastError());
-    if (progress) {
-      MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
-      progress(i + 1, samplesPerPixel);
-    }
-  }
-  MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+  m.LaunchSamples(m.filmSamples, m.filmSamples + (uint32_t)samplesPerPixel, nullptr, nullptr, progress, counters);
   m.filmSamples += (uint32_t)samplesPerPixel;
-
   m.DownloadFilm(host);
   film.AddSamples((uint32_t)samplesPerPixel);
-  if (counters) {
-    TraceCounters c;
-    m.counters.Download(&c, sizeof c);
-    *counters += c;
-  }
 }
 
 void GpuRenderer::RenderTo(Film& film, const std::vector<uint32_t>& targetCounts, TraceCounters* counters,
@@ -274,30 +279,10 @@ void GpuRenderer::RenderTo(Film& film, const std::vector<uint32_t>& targetCounts
   m.rangeEnd.Allocate(pixels * sizeof(uint32_t), "sample counts");
   m.rangeFirst.Upload(first.data(), pixels * sizeof(uint32_t));
   m.rangeEnd.Upload(end.data(), pixels * sizeof(uint32_t));
-  const FilmView device = m.DeviceFilm();
-  SceneView scene = m.device;
-  scene.camera.width = width;
-  scene.camera.height = height;
-  MMRTM_CUDA_CHECK(cudaMemset(m.counters.Get(), 0, sizeof(TraceCounters)));
-
-  const dim3 block(kBlockX, kBlockY), grid((width + kBlockX - 1) / kBlockX, (height + kBlockY - 1) / kBlockY);
-  for (uint32_t index = lowest; index < highest; ++index) {
-    RenderSampleKernel<<<grid, block>>>(scene, device, index, m.rangeFirst.As<uint32_t>(), m.rangeEnd.As<uint32_t>(),
-                                        m.counters.As<TraceCounters>());
-    MMRTM_CUDA_CHECK(cudaGetLastError());
-    if (progress) {
-      MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
-      progress((int)(index - lowest + 1), (int)(highest - lowest));
-    }
-  }
-  MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+  if (lowest < highest)
+    m.LaunchSamples(lowest, highest, m.rangeFirst.As<uint32_t>(), m.rangeEnd.As<uint32_t>(), progress, counters);
   m.DownloadFilm(host);
   film.SetPixelSamples(std::move(end));
-  if (counters) {
-    TraceCounters c;
-    m.counters.Download(&c, sizeof c);
-    *counters += c;
-  }
 }
 
 }  // namespace mmrtm

@@ -35,8 +35,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
   PixelSample out;
   RGB beta(1.f);
   float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
-  // With one light every mode is the same estimator: One's code (and its
-  // random numbers, so images of one-light scenes do not depend on the mode).
+  // With one light every mode is the same estimator: One's code and random
+  // numbers, so images of one-light scenes do not depend on the mode.
   const LightSampling lightSampling = s.lightCount == 1 ? LightSampling::One : s.settings.lightSampling;
   // The probability that NEE samples a given light, for the MIS weights:
   // 1/K when it picks one of K uniformly; 1 when it estimates the sum over
