@@ -102,7 +102,8 @@ TEST(AdaptiveSampling, CountsSplitTheBudgetByWeight) {
 }
 
 TEST(AdaptiveSampling, ImageDependsOnlyOnTheCounts) {
-  const SceneView view = MakeScene().Build();
+  Scene scene = MakeScene();  // the view points into it: it must outlive the renders
+  const SceneView view = scene.Build();
   std::vector<uint32_t> half(37 * 23), full(37 * 23);
   for (size_t i = 0; i < full.size(); ++i) {
     full[i] = 4 + (uint32_t)(i * 7 % 13);

@@ -29,11 +29,12 @@ bool CpuRenderer::RenderTo(const SceneView& scene, Film& film, const std::vector
   if (targetCounts.size() != pixels)
     throw std::invalid_argument("CpuRenderer::RenderTo: " + std::to_string(targetCounts.size()) +
                                 " sample counts for " + std::to_string(pixels) + " pixels");
-  const auto end = [&](size_t pixel, uint32_t first) { return std::max(first, targetCounts[pixel]); };
-  if (!RenderRanges(scene, film, end, counters, progress, cancel)) return false;
+  // Each pixel ends with its target, or its own count where that is more.
   std::vector<uint32_t> counts(pixels);
   for (size_t i = 0; i < pixels; ++i)
     counts[i] = std::max(film.PixelSamples((int)(i % film.Width()), (int)(i / film.Width())), targetCounts[i]);
+  if (!RenderRanges(scene, film, [&](size_t pixel, uint32_t) { return counts[pixel]; }, counters, progress, cancel))
+    return false;
   film.SetPixelSamples(std::move(counts));
   return true;
 }
