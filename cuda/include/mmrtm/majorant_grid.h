@@ -16,6 +16,8 @@
 //   - tau above kDescendOpticalThickness descends to the child under the ray;
 //   - otherwise (or at the root or a leaf) the node is one majorant segment,
 //     and the walk continues with its neighbour on the same level (3D-DDA).
+// A walk starts at the leaf under the ray's first point and applies the same
+// rules from there (it climbs as far as they allow before its first segment).
 // The paper states its thresholds 0.2 and 0.6 on the "maximum attenuation
 // coefficient" of a node; here they apply to the node's optical thickness
 // (majorant times node width), which makes them independent of units and
@@ -61,7 +63,14 @@ class GridMajorantIterator {
   MMRTM_CPU_GPU GridMajorantIterator(const MajorantGridView* grid, GridTraversal traversal, const Ray& r,
                                      float tMin, float tMax, float scale)
       : grid_(grid), o_(r.o), d_(r.d), t_(tMin), tEnd_(tMax), scale_(scale), traversal_(traversal) {
-    level_ = traversal == GridTraversal::Macrocell ? grid->leafLevel : 0;
+    // Both start at the leaf the ray begins in. For the octree that is where
+    // most rays begin (scattered and shadow rays start in matter) and the
+    // rules below climb from there where nodes are thin or empty; starting
+    // at the root cost every ray a descent through all levels.
+    level_ = grid->leafLevel;
+    // A multiply per face crossing instead of a division (0 where the ray
+    // is parallel to an axis, which ExitDistance skips).
+    for (int a = 0; a < 3; ++a) invD_[a] = d_[a] != 0.f ? 1.f / d_[a] : 0.f;
     Vec3 p = r(tMin);
     for (int a = 0; a < 3; ++a) {
       float x = p[a] / (float)grid->nodeSize[level_];
@@ -143,7 +152,7 @@ class GridMajorantIterator {
     for (int a = 0; a < 3; ++a) {
       if (d_[a] == 0.f) continue;
       float plane = d_[a] > 0.f ? Min((float)(cell_[a] + 1) * size, (float)grid_->cells[a]) : (float)cell_[a] * size;
-      float t = (plane - o_[a]) / d_[a];
+      float t = (plane - o_[a]) * invD_[a];
       if (t < tExit) {
         tExit = t;
         axis = a;
@@ -171,6 +180,7 @@ class GridMajorantIterator {
 
   const MajorantGridView* grid_ = nullptr;
   Vec3 o_, d_;
+  float invD_[3] = {0.f, 0.f, 0.f};
   float t_ = 0.f, tEnd_ = 0.f, scale_ = 1.f;
   int level_ = 0;
   int cell_[3] = {0, 0, 0};
