@@ -15,6 +15,15 @@ DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 HEADSQ = os.path.join(DATA, "ct_head_headsq.nrrd")  # 64 x 64 x 93, small and fast
 
 
+def read_pfm_pixels(data):
+    """The floats of a colour PFM's bytes (little-endian, as mmrtm-render writes)."""
+    header_end = 0
+    for _ in range(3):
+        header_end = data.index(b"\n", header_end) + 1
+    width, height = (int(v) for v in data.split(b"\n")[1].split())
+    return struct.unpack("<%df" % (width * height * 3), data[header_end:])
+
+
 class RenderCli(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -215,6 +224,50 @@ class RenderCli(unittest.TestCase):
         scene = self.write("scene.json", json.dumps({"render": {"light_sampling": "every"}}))
         self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-bone", "--scene", scene), "render.light_sampling", "every")
 
+    def test_denoised_preview(self):
+        # A biased extra image (Documentation/denoising.md): the unbiased
+        # outputs are the same bits with it as without it.
+        preview = os.path.join(self.dir, "preview.pfm")
+        plain, plain_pixels = self.render_linear("plain", "--spp", "4")
+        self.assertIsNone(plain["denoised_preview"])
+        r = self.run_render(HEADSQ, "--width", "8", "--height", "8", "--spp", "1", "--denoised-preview", preview)
+        if r.returncode != 0 and "Open Image Denoise not found" in r.stderr:
+            self.skipTest("no Open Image Denoise library (scripts/install-dependencies.sh installs the oidn wheel): "
+                          + r.stderr.strip().splitlines()[-1])
+        stats, pixels = self.render_linear("with", "--spp", "4", "--denoised-preview", preview)
+        self.assertEqual(pixels, plain_pixels)
+        p = stats["denoised_preview"]
+        self.assertTrue(p["biased"])
+        self.assertIn("Open Image Denoise", p["denoiser"])
+        self.assertEqual(p["feature_spp"], 0)
+        # A 1-spp preview is nearer a 256-spp render (another seed) than the
+        # 1-spp image is (0.27-0.28 of its RMSE over four seeds), and as
+        # bright (within 0.3 %): not a black or blurred-away image.
+        size = ("--width", "80", "--height", "60")
+        _, raw = self.render_linear("raw", *size, "--spp", "1", "--denoised-preview", preview)
+        _, reference = self.render_linear("reference", *size, "--spp", "256", "--seed", "9")
+        ref, raw = read_pfm_pixels(reference), read_pfm_pixels(raw)
+        with open(preview, "rb") as f:
+            denoised = read_pfm_pixels(f.read())
+        rmse = lambda a: (sum((x - y) ** 2 for x, y in zip(a, ref)) / len(ref)) ** 0.5
+        self.assertLess(rmse(denoised), 0.4 * rmse(raw), (rmse(denoised), rmse(raw)))
+        self.assertAlmostEqual(sum(denoised) / sum(ref), 1.0, delta=0.03)
+        # Guided by first-hit features, and as a PNG.
+        png = os.path.join(self.dir, "preview.png")
+        stats, _ = self.render_linear("guided", "--spp", "4", "--denoised-preview", png, "--preview-features", "4")
+        self.assertEqual(stats["denoised_preview"]["feature_spp"], 4)
+        with open(png, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        # No library: an error before rendering that names what was tried; no output.
+        for f in os.listdir(self.dir):
+            os.remove(os.path.join(self.dir, f))
+        r = subprocess.run([RENDER, HEADSQ, "--spp", "1", "--denoised-preview", png, "--output", self.png, "--quiet"],
+                           capture_output=True, text=True, timeout=300,
+                           env=dict(os.environ, MMRTM_OIDN_LIBRARY=os.path.join(self.dir, "libnone.so")))
+        self.expect_failure(r, "Open Image Denoise not found", "libnone.so")
+        self.assertFalse(os.path.exists(png))
+        self.expect_failure(self.run_render(HEADSQ, "--preview-features", "-1"), "--preview-features", code=2)
+
     def test_degenerate_volumes(self):
         # One voxel, a 1 x 1 x 1000 line, a single slice: nothing to render,
         # said clearly instead of an empty image (or a camera error).
@@ -292,7 +345,7 @@ class RenderCli(unittest.TestCase):
         self.assertEqual(r.returncode, 0)
         for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--backend", "--width", "--height", "--spp", "--seed", "--threads",
                        "--estimator", "--output", "--output-linear", "--stats-json", "--noise-target", "--sampling",
-                       "--light-sampling"]:
+                       "--light-sampling", "--denoised-preview", "--preview-features"]:
             self.assertIn(option, r.stdout)
 
 

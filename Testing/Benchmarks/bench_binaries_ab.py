@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Two builds of mmrtm-render, A and B, on the five reference scenes of
+Testing/Accuracy (mmrtm_accuracy.SCENES), taking turns so that the machine's
+noise falls on both alike: the median render time of each, their ratio, and
+the counters per sample that say where a difference comes from (majorant
+segments, density lookups) with the relative noise, which must agree for a
+change that only makes samples cheaper.
+
+    .venv/bin/python Testing/Benchmarks/bench_binaries_ab.py A/bin/mmrtm-render B/bin/mmrtm-render \\
+        [--size 128] [--spp 32] [--repeats 3] [--only NAME ...]
+
+Needs the shared data (MMRTM_SHARED_DATA_DIR or ../shared/data), not the references.
+"""
+
+import argparse
+import statistics
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "Accuracy"))
+import mmrtm_accuracy as acc  # noqa: E402
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("a")
+    parser.add_argument("b")
+    parser.add_argument("--size", type=int, default=128)
+    parser.add_argument("--spp", type=int, default=32)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
+    args = parser.parse_args()
+    print("| scene | A s | B s | A / B | segments per sample, A / B | lookups per sample, A / B | relative noise, A / B |")
+    print("|---|---|---|---|---|---|---|")
+    for name in args.only or list(acc.SCENES):
+        times, stats = {"a": [], "b": []}, {}
+        for _ in range(args.repeats):
+            for key in ("a", "b"):
+                r = acc.render(acc.SCENES[name]["args"], args.size, args.size, args.spp, seed=3,
+                               extra=["--shadow-scale", "1"], binary=getattr(args, key))
+                times[key].append(r.seconds)
+                stats[key] = r.stats
+        ta, tb = statistics.median(times["a"]), statistics.median(times["b"])
+        per = lambda key, counter: stats[key][counter] / stats[key]["samples"]  # noqa: E731
+        print(f"| {acc.SCENES[name]['title']} | {ta:.2f} | {tb:.2f} | {ta / tb:.2f} | "
+              f"{per('a', 'majorant_segments'):.1f} / {per('b', 'majorant_segments'):.1f} | "
+              f"{per('a', 'density_lookups'):.2f} / {per('b', 'density_lookups'):.2f} | "
+              f"{stats['a']['noise']['relative']:.4f} / {stats['b']['noise']['relative']:.4f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

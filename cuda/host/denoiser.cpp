@@ -1,0 +1,156 @@
+#include "denoiser.h"
+
+#include <dlfcn.h>
+
+#include <cstddef>
+#include <cstdlib>
+#include <filesystem>
+#include <vector>
+
+namespace mmrtm {
+
+static_assert(sizeof(RGB) == 3 * sizeof(float), "RGBImage pixels are passed to OIDN as packed float3");
+
+// The few functions of OIDN's C API used here (OpenImageDenoise/oidn.h;
+// the same signatures in 1.4 and 2.x).
+struct Denoiser::Api {
+  void* library = nullptr;
+  void* (*newDevice)(int type) = nullptr;
+  void (*setDeviceInt)(void* device, const char* name, int value) = nullptr;
+  int (*getDeviceInt)(void* device, const char* name) = nullptr;
+  void (*commitDevice)(void* device) = nullptr;
+  int (*getDeviceError)(void* device, const char** message) = nullptr;
+  void (*releaseDevice)(void* device) = nullptr;
+  void* (*newFilter)(void* device, const char* type) = nullptr;
+  void (*setSharedFilterImage)(void* filter, const char* name, void* ptr, int format, size_t width, size_t height,
+                               size_t byteOffset, size_t bytePixelStride, size_t byteRowStride) = nullptr;
+  void (*setFilterBool)(void* filter, const char* name, bool value) = nullptr;
+  void (*commitFilter)(void* filter) = nullptr;
+  void (*executeFilter)(void* filter) = nullptr;
+  void (*releaseFilter)(void* filter) = nullptr;
+};
+
+namespace {
+
+constexpr int kDeviceTypeCpu = 1;  // OIDN_DEVICE_TYPE_CPU
+constexpr int kFormatFloat3 = 3;   // OIDN_FORMAT_FLOAT3
+
+// The places to look, in order (denoiser.h).
+std::vector<std::string> CandidatePaths() {
+  std::vector<std::string> paths;
+  if (const char* env = std::getenv("MMRTM_OIDN_LIBRARY"); env && *env) return {env};
+#ifdef MMRTM_OIDN_DEFAULT_LIBRARY
+  paths.push_back(MMRTM_OIDN_DEFAULT_LIBRARY);
+#endif
+  paths.push_back("libOpenImageDenoise.so.2");
+  paths.push_back("libOpenImageDenoise.so.1");
+  return paths;
+}
+
+// dlopen, and once more after the TBB that a wheel ships beside the library
+// where the system has none.
+void* OpenLibrary(const std::string& path, std::string* error) {
+  if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
+  *error = dlerror();
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(path).parent_path();
+  std::error_code ec;
+  if (folder.empty() || !fs::is_directory(folder, ec)) return nullptr;
+  for (const auto& entry : fs::directory_iterator(folder, ec))
+    if (entry.path().filename().string().rfind("libtbb.so", 0) == 0 &&
+        dlopen(entry.path().c_str(), RTLD_NOW | RTLD_GLOBAL))
+      if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
+  return nullptr;
+}
+
+// `name`, or `older` (OIDN 2 renamed the typed setters and getters: the
+// same signatures).
+template <typename F>
+void Bind(void* library, const char* name, F* fn, const std::string& path, const char* older = nullptr) {
+  *fn = reinterpret_cast<F>(dlsym(library, name));
+  if (!*fn && older) *fn = reinterpret_cast<F>(dlsym(library, older));
+  if (!*fn) throw DenoiserError(path + ": not Open Image Denoise (no " + name + ")");
+}
+
+}  // namespace
+
+std::unique_ptr<Denoiser> Denoiser::Load(int threads) {
+  std::string tried;
+  auto api = std::make_unique<Api>();
+  std::string path;
+  for (const std::string& candidate : CandidatePaths()) {
+    std::string error;
+    if ((api->library = OpenLibrary(candidate, &error))) {
+      path = candidate;
+      break;
+    }
+    tried += "\n  " + candidate + ": " + error;
+  }
+  if (!api->library)
+    throw DenoiserError("Intel Open Image Denoise not found (scripts/install-dependencies.sh installs the `oidn` "
+                        "wheel into .venv; MMRTM_OIDN_LIBRARY names a library). Tried:" + tried);
+  Api& a = *api;
+  Bind(a.library, "oidnNewDevice", &a.newDevice, path);
+  Bind(a.library, "oidnSetDeviceInt", &a.setDeviceInt, path, "oidnSetDevice1i");
+  Bind(a.library, "oidnGetDeviceInt", &a.getDeviceInt, path, "oidnGetDevice1i");
+  Bind(a.library, "oidnCommitDevice", &a.commitDevice, path);
+  Bind(a.library, "oidnGetDeviceError", &a.getDeviceError, path);
+  Bind(a.library, "oidnReleaseDevice", &a.releaseDevice, path);
+  Bind(a.library, "oidnNewFilter", &a.newFilter, path);
+  Bind(a.library, "oidnSetSharedFilterImage", &a.setSharedFilterImage, path);
+  Bind(a.library, "oidnSetFilterBool", &a.setFilterBool, path, "oidnSetFilter1b");
+  Bind(a.library, "oidnCommitFilter", &a.commitFilter, path);
+  Bind(a.library, "oidnExecuteFilter", &a.executeFilter, path);
+  Bind(a.library, "oidnReleaseFilter", &a.releaseFilter, path);
+
+  std::unique_ptr<Denoiser> d(new Denoiser());
+  d->api_ = std::move(api);
+  d->path_ = path;
+  d->device_ = a.newDevice(kDeviceTypeCpu);
+  if (!d->device_) throw DenoiserError(path + ": no CPU device");
+  if (threads > 0) a.setDeviceInt(d->device_, "numThreads", threads);
+  a.commitDevice(d->device_);
+  const char* message = nullptr;
+  if (a.getDeviceError(d->device_, &message) != 0)
+    throw DenoiserError(path + ": " + (message ? message : "the device failed"));
+  d->version_ = a.getDeviceInt(d->device_, "version");
+  return d;
+}
+
+Denoiser::~Denoiser() {
+  if (api_ && device_) api_->releaseDevice(device_);
+  // The library stays loaded: OIDN's threads may outlive the device briefly.
+}
+
+std::string Denoiser::Description() const {
+  return "Intel Open Image Denoise " + std::to_string(version_ / 10000) + "." + std::to_string(version_ / 100 % 100) +
+         "." + std::to_string(version_ % 100) + " (" + path_ + ")";
+}
+
+RGBImage Denoiser::Denoise(const RGBImage& color, const RGBImage* albedo, const RGBImage* normal) const {
+  const Api& a = *api_;
+  const auto sameSize = [&](const RGBImage* image) {
+    return !image || (image->width == color.width && image->height == color.height);
+  };
+  if (!sameSize(albedo) || !sameSize(normal)) throw DenoiserError("the albedo or normal image is not the colour's size");
+  RGBImage out{color.width, color.height, std::vector<RGB>(color.pixels.size())};
+  const auto share = [&](void* filter, const char* name, const RGBImage& image) {
+    a.setSharedFilterImage(filter, name, const_cast<RGB*>(image.pixels.data()), kFormatFloat3, (size_t)image.width,
+                           (size_t)image.height, 0, 0, 0);
+  };
+  void* filter = a.newFilter(device_, "RT");
+  share(filter, "color", color);
+  if (albedo) share(filter, "albedo", *albedo);
+  if (albedo && normal) share(filter, "normal", *normal);  // OIDN takes a normal only with an albedo
+  share(filter, "output", out);
+  a.setFilterBool(filter, "hdr", true);
+  a.commitFilter(filter);
+  a.executeFilter(filter);
+  a.releaseFilter(filter);
+  const char* message = nullptr;
+  if (a.getDeviceError(device_, &message) != 0)
+    throw DenoiserError(path_ + ": " + (message ? message : "the filter failed"));
+  return out;
+}
+
+}  // namespace mmrtm
