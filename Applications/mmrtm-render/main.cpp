@@ -6,6 +6,7 @@
 // package with the ct-bone preset. Progress goes to stderr, the image to the
 // named file; the exit code is 0 only on success. See --help.
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -151,6 +152,13 @@ double ParseReal(const std::string& flag, const std::string& text) {
   return v;
 }
 
+// ".png" for "a/b.PNG".
+std::string LowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return (char)std::tolower(c); });
+  return ext;
+}
+
 Options ParseArguments(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -194,7 +202,12 @@ Options ParseArguments(int argc, char** argv) {
     } else if (a == "--leaf-level") o.render["leaf_level"] = ParseInteger(a, value(), -1, 11);
     else if (a == "--output") o.output = value();
     else if (a == "--output-linear") o.outputLinear = value();
-    else if (a == "--denoised-preview") o.denoisedPreview = value();
+    else if (a == "--denoised-preview") {
+      o.denoisedPreview = value();
+      const std::string ext = LowerExtension(o.denoisedPreview);
+      if (ext != ".png" && ext != ".pfm")
+        UsageError("--denoised-preview expects a .png or .pfm file, got '" + o.denoisedPreview + "'");
+    }
     else if (a == "--preview-features") o.previewFeatureSpp = (int)ParseInteger(a, value(), 0, 4096);
     else if (a == "--output-variance") o.outputVariance = value();
     else if (a == "--ray-march-step") o.render["ray_march_step"] = ParseReal(a, value());
@@ -326,8 +339,7 @@ json WriteDenoisedPreview(const std::string& path, const mmrtm::Denoiser& denois
                                        ? denoiser.Denoise(film.Linear(), &features.albedo, &features.normal)
                                        : denoiser.Denoise(film.Linear(), nullptr, nullptr);
   const double denoiseSeconds = SecondsSince(t1);
-  const std::string ext = fs::path(path).extension().string();
-  if (ext == ".pfm" || ext == ".PFM") {
+  if (LowerExtension(path) == ".pfm") {  // else .png (ParseArguments)
     mmrtm::WritePFM(path, denoised);
   } else {
     std::vector<uint8_t> png((size_t)denoised.width * denoised.height * 3);

@@ -233,6 +233,8 @@ class RenderCli(unittest.TestCase):
         self.expect_failure(r, "Open Image Denoise not found", "libnone.so")
         self.assertFalse(os.path.exists(png))
         self.expect_failure(self.run_render(HEADSQ, "--preview-features", "-1"), "--preview-features", code=2)
+        self.expect_failure(self.run_render(HEADSQ, "--denoised-preview", os.path.join(self.dir, "p.exr")),
+                            "--denoised-preview expects a .png or .pfm", code=2)
         if os.environ.get("MMRTM_SANITIZED"):
             self.skipTest("Open Image Denoise under sanitizers: its TBB dlopens with RTLD_DEEPBIND, which the "
                           "sanitizer runtime refuses (the Release build runs this test)")
