@@ -65,12 +65,9 @@ def measure(name, max_spp, keep):
     return rows
 
 
-def time_to(rows, target):
-    """The first measured time at which `rows` reach the error `target`, or None."""
-    for r in rows:
-        if r["rel_rmse"] <= target:
-            return r["seconds"]
-    return None
+def first_reaching(rows, target):
+    """The first measured row whose error is at most `target`, or None."""
+    return next((r for r in rows if r["rel_rmse"] <= target), None)
 
 
 def table(results):
@@ -82,10 +79,9 @@ def table(results):
         last = rows[VARIANTS[0][0]][-1]
         best = None
         for label, _, _, _ in VARIANTS[1:]:
-            t = time_to(rows[label], last["rel_rmse"])
-            if t is not None and (best is None or t < best[1]):
-                spp = next(r["spp"] for r in rows[label] if r["seconds"] == t)
-                best = (f"{label.split(', ')[-1]}, {spp} spp", t)
+            r = first_reaching(rows[label], last["rel_rmse"])
+            if r is not None and (best is None or r["seconds"] < best[1]):
+                best = (f"{label.split(', ')[-1]}, {r['spp']} spp", r["seconds"])
         lowest = min(r["rel_rmse"] for label, _, _, _ in VARIANTS[1:] for r in rows[label])
         reach = (best[0], f"{best[1]:.2f} s", f"{last['seconds'] / best[1]:.1f}") if best else ("none", "", "")
         lines.append(f"| {acc.SCENES[name]['title']} | {last['spp']}, {last['seconds']:.2f} s, {last['rel_rmse']:.4f} | "

@@ -37,8 +37,8 @@ constexpr int kFormatFloat3 = 3;   // OIDN_FORMAT_FLOAT3
 
 // The places to look, in order (denoiser.h).
 std::vector<std::string> CandidatePaths() {
-  std::vector<std::string> paths;
   if (const char* env = std::getenv("MMRTM_OIDN_LIBRARY"); env && *env) return {env};
+  std::vector<std::string> paths;
 #ifdef MMRTM_OIDN_DEFAULT_LIBRARY
   paths.push_back(MMRTM_OIDN_DEFAULT_LIBRARY);
 #endif
