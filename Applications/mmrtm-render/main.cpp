@@ -68,6 +68,8 @@ options:
   --sampling S          uniform (every pixel --spp samples; default) or adaptive
                         (a pilot pass, then each pixel's share of a mean of --spp
                         in proportion to its neighbours' noise; unbiased)
+  --sampler S           sobol (Owen-scrambled Sobol' numbers for the pixel, lens and
+                        first scattering; default) or independent (all from PCG32)
   --seed S              random seed (default: scene, else 0)
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
@@ -224,6 +226,10 @@ Options ParseArguments(int argc, char** argv) {
       const std::string v = value();
       if (v != "uniform" && v != "adaptive") UsageError("--sampling expects uniform or adaptive, got '" + v + "'");
       o.adaptive = v == "adaptive";
+    } else if (a == "--sampler") {
+      const std::string v = value();
+      if (!mmrtm::ParsePixelSampler(v)) UsageError("--sampler expects sobol or independent, got '" + v + "'");
+      o.render["sampler"] = v;
     } else if (a == "--quiet") o.quiet = true;
     else if (a.size() > 1 && a[0] == '-') UsageError("unknown option " + a);
     else if (o.input.empty()) o.input = a;
@@ -467,6 +473,7 @@ int Run(const Options& o) {
         {"height", film.Height()},
         {"spp", film.Adaptive() ? json(film.MeanSamples()) : json(film.Samples())},
         {"sampling", film.Adaptive() ? "adaptive" : "uniform"},
+        {"sampler", mmrtm::PixelSamplerName(rs.integrator.sampler)},
         {"spp_min", film.Samples()},
         {"spp_max", film.MaxSamples()},
         {"noise_target", o.noiseTarget > 0 ? json(o.noiseTarget) : json(nullptr)},

@@ -224,6 +224,21 @@ class RenderCli(unittest.TestCase):
         scene = self.write("scene.json", json.dumps({"render": {"light_sampling": "every"}}))
         self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-bone", "--scene", scene), "render.light_sampling", "every")
 
+    def test_pixel_sampler(self):
+        # Sobol' pairs by default, reported; other numbers than independent
+        # ones; the same image at any thread count.
+        sobol, sobol_pixels = self.render_linear("sobol", "--spp", "8")
+        self.assertEqual(sobol["sampler"], "sobol")
+        _, again = self.render_linear("again", "--spp", "8", "--threads", "1", "--sampler", "sobol")
+        self.assertEqual(again, sobol_pixels, "the same image at any thread count")
+        independent, independent_pixels = self.render_linear("independent", "--spp", "8", "--sampler", "independent")
+        self.assertEqual(independent["sampler"], "independent")
+        self.assertNotEqual(independent_pixels, sobol_pixels)
+        os.remove(self.png)
+        self.expect_failure(self.run_render(HEADSQ, "--sampler", "halton"), "--sampler", code=2)
+        scene = self.write("scene.json", json.dumps({"render": {"sampler": "halton"}}))
+        self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-bone", "--scene", scene), "render.sampler", "halton")
+
     def test_denoised_preview(self):
         # No library: an error before rendering that names what was tried; no output.
         png = os.path.join(self.dir, "preview.png")
@@ -350,7 +365,7 @@ class RenderCli(unittest.TestCase):
         self.assertEqual(r.returncode, 0)
         for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--backend", "--width", "--height", "--spp", "--seed", "--threads",
                        "--estimator", "--output", "--output-linear", "--stats-json", "--noise-target", "--sampling",
-                       "--light-sampling", "--denoised-preview", "--preview-features"]:
+                       "--light-sampling", "--sampler", "--denoised-preview", "--preview-features"]:
             self.assertIn(option, r.stdout)
 
 

@@ -539,7 +539,7 @@ class Parser {
       CheckKeys(rj, w,
                 {"width", "height", "spp", "seed", "threads", "estimator", "max_bounces", "russian_roulette_depth",
                  "shadow_extinction_scale", "ray_march_step", "exposure", "tone_mapper", "background", "accelerator",
-                 "leaf_level", "light_sampling"});
+                 "leaf_level", "light_sampling", "sampler"});
       r.width = IntegerOr(rj, "width", r.width, w);
       r.height = IntegerOr(rj, "height", r.height, w);
       r.samplesPerPixel = IntegerOr(rj, "spp", r.samplesPerPixel, w);
@@ -561,6 +561,10 @@ class Parser {
       const std::optional<LightSampling> lightSampling = ParseLightSampling(lights);
       if (!lightSampling) Fail(w + ".light_sampling", "expected one, all or resampled, got '" + lights + "'");
       r.integrator.lightSampling = *lightSampling;
+      const std::string sampler = StringOr(rj, "sampler", PixelSamplerName(r.integrator.sampler), w);
+      const std::optional<PixelSampler> pixelSampler = ParsePixelSampler(sampler);
+      if (!pixelSampler) Fail(w + ".sampler", "expected sobol or independent, got '" + sampler + "'");
+      r.integrator.sampler = *pixelSampler;
       const std::string acc = StringOr(rj, "accelerator", "octree", w);
       AcceleratorSettings& a = r.accelerator;
       if (acc == "none") a.kind = MajorantKind::Global;
@@ -664,6 +668,16 @@ const char* LightSamplingName(LightSampling mode) {
     case LightSampling::Resampled: return "resampled";
   }
   return "one";
+}
+
+std::optional<PixelSampler> ParsePixelSampler(const std::string& name) {
+  if (name == "sobol") return PixelSampler::Sobol;
+  if (name == "independent") return PixelSampler::Independent;
+  return std::nullopt;
+}
+
+const char* PixelSamplerName(PixelSampler sampler) {
+  return sampler == PixelSampler::Independent ? "independent" : "sobol";
 }
 
 }  // namespace mmrtm

@@ -56,4 +56,9 @@ std::string PresetPath(const std::string& presetDirectory, const std::string& na
 std::optional<LightSampling> ParseLightSampling(const std::string& name);
 const char* LightSamplingName(LightSampling mode);
 
+// The scene file's names of the pixel samplers ("sobol", "independent");
+// nullopt for another name.
+std::optional<PixelSampler> ParsePixelSampler(const std::string& name);
+const char* PixelSamplerName(PixelSampler sampler);
+
 }  // namespace mmrtm

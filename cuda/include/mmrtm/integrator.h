@@ -18,9 +18,41 @@
 
 #include "mmrtm/bsdf.h"
 #include "mmrtm/phase.h"
+#include "mmrtm/sobol.h"
 #include "mmrtm/tracking.h"
 
 namespace mmrtm {
+
+// The pairs of low-discrepancy numbers of a pixel sample (mmrtm/sobol.h),
+// with IntegratorSettings::sampler Sobol: the pixel position, the lens, and
+// the first kSobolVertices vertices of the path, where a pixel's samples
+// differ most in what they see (where the camera ray first collides, which
+// particle scatters there, the light it samples, how much of that light
+// arrives and the direction the path leaves in). The rest of the path draws
+// from its PCG32 stream.
+constexpr int kPairPixel = 0;
+constexpr int kPairLens = 1;
+constexpr int kPairFirstVertex = 2;
+constexpr int kSobolVertices = 2;
+// Each vertex's pairs, from kPairFirstVertex + depth * kPairsPerVertex:
+constexpr int kPairFreePath = 0;   // the free path's first arrival and its real-or-null choice
+constexpr int kPairParticle = 1;   // surface or volume particle; the BSDF lobe
+constexpr int kPairLight = 2;      // the light sample of next-event estimation
+constexpr int kPairShadow = 3;     // the shadow ray's first arrival; which light
+constexpr int kPairDirection = 4;  // the scattered direction
+constexpr int kPairsPerVertex = 5;
+
+// Uses uniform u for a choice of probability p and returns a uniform again,
+// for the next choice (the part of [0, 1) that u fell in, stretched), so
+// that one stratified number can make a sequence of choices.
+MMRTM_CPU_GPU inline bool ChooseAndReuse(float p, float* u) {
+  if (*u < p) {
+    *u = Min(*u / p, kOneMinusEpsilon);
+    return true;
+  }
+  *u = Min((*u - p) / (1.f - p), kOneMinusEpsilon);
+  return false;
+}
 
 struct PixelSample {
   RGB L;
@@ -30,8 +62,9 @@ struct PixelSample {
 // `cameraTMax`: how far the camera ray may go (opaque geometry of the host
 // application in front, e.g. a VTK mesh); beyond it the pixel is not the
 // volume's and nothing (not even the environment) is seen.
+// `pairs`, when given, supplies the first vertices' numbers.
 MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, TraceCounters& ctr,
-                                    float cameraTMax = kInfinity) {
+                                    float cameraTMax = kInfinity, const SobolPairs* pairs = nullptr) {
   PixelSample out;
   RGB beta(1.f);
   float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
@@ -45,7 +78,13 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
                          : lightSampling == LightSampling::One ? 1.f / (float)s.lightCount
                                                                : 1.f;
   for (int depth = 0;; ++depth) {
-    FreePathResult fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr);
+    // This vertex's low-discrepancy pairs, or none (then rng).
+    const SobolPairs* ld = depth < kSobolVertices ? pairs : nullptr;
+    const int pairBase = kPairFirstVertex + depth * kPairsPerVertex;
+    float ldFreePath[2];
+    if (ld) ld->Get(pairBase + kPairFreePath, &ldFreePath[0], &ldFreePath[1]);
+    FreePathResult fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr,
+                                       ld ? ldFreePath : nullptr);
     if (!fp.collided) {
       if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
@@ -69,7 +108,9 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     // Which particle scattered: surface (BSDF) with probability P_fs.
     bool surface = false;
     SurfaceBSDF bsdf;
-    if (k.surfaceProbability > 0.f && rng.Uniform() < k.surfaceProbability) {
+    float ldParticle[2];
+    if (ld) ld->Get(pairBase + kPairParticle, &ldParticle[0], &ldParticle[1]);
+    if (k.surfaceProbability > 0.f && (ld ? ldParticle[0] : rng.Uniform()) < k.surfaceProbability) {
       Vec3 G = s.classifier.Gradient(p);
       float len = Length(G);
       if (len > 0.f && isfinite(len)) {
@@ -86,7 +127,13 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
       // false when it has none.
       LightSample ls;
       auto unshadowed = [&](int li, RGB* c) {
-        float u0 = rng.Uniform(), u1 = rng.Uniform();
+        float u0, u1;
+        if (ld) {
+          ld->Get(pairBase + kPairLight, &u0, &u1);
+        } else {
+          u0 = rng.Uniform();
+          u1 = rng.Uniform();
+        }
         ls = SampleLight(s.lights[li], s.environment, p, u0, u1);
         if (ls.pdf <= 0.f || ls.L.IsBlack()) return false;
         RGB f = surface ? bsdf.Eval(wo, ls.wi) : RGB(phase.p(wo, ls.wi));
@@ -96,16 +143,22 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
         *c = beta * f * ls.L * (w / lightPdf);
         return true;
       };
+      // The shadow ray's first arrival and the choice of light: a pair,
+      // or (negative) drawn from rng.
+      float ldShadow[2] = {-1.f, -1.f};
+      if (ld) ld->Get(pairBase + kPairShadow, &ldShadow[0], &ldShadow[1]);
       RGB c;
       switch (lightSampling) {
         case LightSampling::One: {
-          int li = ClampInt((int)(rng.Uniform() * s.lightCount), 0, s.lightCount - 1);
-          if (unshadowed(li, &c)) out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr);
+          const float u = ld ? ldShadow[1] : rng.Uniform();
+          int li = ClampInt((int)(u * s.lightCount), 0, s.lightCount - 1);
+          if (unshadowed(li, &c)) out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr, ldShadow[0]);
           break;
         }
         case LightSampling::All:
           for (int li = 0; li < s.lightCount; ++li)
-            if (unshadowed(li, &c)) out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr);
+            if (unshadowed(li, &c))
+              out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr, ldShadow[0]);
           break;
         case LightSampling::Resampled: {
           // One candidate per light, one kept with probability in
@@ -121,7 +174,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
             const float weight = Luminance(c);
             if (!(weight > 0.f)) continue;
             weightSum += weight;
-            if (rng.Uniform() * weightSum < weight) {
+            const bool keep = ld ? ChooseAndReuse(weight / weightSum, &ldShadow[1]) : rng.Uniform() * weightSum < weight;
+            if (keep) {
               kept = c;
               keptDir = ls.wi;
               keptDistance = ls.distance;
@@ -129,14 +183,23 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
             }
           }
           if (keptWeight > 0.f)
-            out.L += kept * (Transmittance(s, Ray{p, keptDir}, keptDistance, rng, ctr) * weightSum / keptWeight);
+            out.L += kept * (Transmittance(s, Ray{p, keptDir}, keptDistance, rng, ctr, ldShadow[0]) * weightSum /
+                             keptWeight);
           break;
         }
       }
     }
 
     // Continue the path.
-    float uLobe = rng.Uniform(), u0 = rng.Uniform(), u1 = rng.Uniform();
+    float uLobe, u0, u1;
+    if (ld) {
+      uLobe = ldParticle[1];
+      ld->Get(pairBase + kPairDirection, &u0, &u1);
+    } else {
+      uLobe = rng.Uniform();
+      u0 = rng.Uniform();
+      u1 = rng.Uniform();
+    }
     Vec3 wi;
     if (surface) {
       BSDFSample bs = bsdf.Sample(wo, uLobe, u0, u1);
@@ -161,15 +224,29 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
 }
 
 // One sample of pixel (x, y): its own random stream (DESIGN.md rule 2), a
-// box-filtered position in the pixel, a lens position, and the path.
+// box-filtered position in the pixel, a lens position, and the path; with
+// the Sobol' sampler the first two and the first vertex's numbers are
+// Owen-scrambled Sobol' pairs of the same (seed, pixel, sample index).
 MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, int y, uint32_t sampleIndex,
                                                    TraceCounters& ctr) {
-  PCG32 rng = PixelSampleRNG(s.settings.seed, (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y, sampleIndex);
-  float fx = rng.Uniform(), fy = rng.Uniform(), l0 = rng.Uniform(), l1 = rng.Uniform();
+  const uint64_t pixel = (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y;
+  PCG32 rng = PixelSampleRNG(s.settings.seed, pixel, sampleIndex);
+  float fx, fy, l0 = 0.f, l1 = 0.f;
+  const bool sobol = s.settings.sampler == PixelSampler::Sobol;
+  const SobolPairs pairs(s.settings.seed, pixel, sampleIndex);
+  if (sobol) {
+    pairs.Get(kPairPixel, &fx, &fy);
+    if (s.camera.lensRadius > 0.f) pairs.Get(kPairLens, &l0, &l1);
+  } else {
+    fx = rng.Uniform();
+    fy = rng.Uniform();
+    l0 = rng.Uniform();
+    l1 = rng.Uniform();
+  }
   Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
   ++ctr.paths;
   const float tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
-  return Li(s, ray, rng, ctr, tMax);
+  return Li(s, ray, rng, ctr, tMax, sobol ? &pairs : nullptr);
 }
 
 }  // namespace mmrtm

@@ -26,6 +26,13 @@ enum class LightSampling {
   Resampled  // one light chosen by its unshadowed contribution, one shadow ray
 };
 
+// Where the first dimensions of a path come from (mmrtm/sobol.h).
+enum class PixelSampler : uint8_t {
+  Independent,  // every number from the sample's PCG32 stream
+  Sobol         // Owen-scrambled Sobol' pairs for the pixel, the lens and the
+                // first vertex (the default); the rest from the stream
+};
+
 struct IntegratorSettings {
   Estimator estimator = Estimator::DeltaTracking;
   int maxBounces = 32;         // real scattering events per path
@@ -34,6 +41,7 @@ struct IntegratorSettings {
   float rayMarchStep = 0.5f;   // ray marching step, world units
   bool backgroundVisible = true;  // camera rays that escape see the environment
   LightSampling lightSampling = LightSampling::Resampled;
+  PixelSampler sampler = PixelSampler::Sobol;
   uint64_t seed = 0;
 };
 

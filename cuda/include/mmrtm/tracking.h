@@ -47,15 +47,18 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, f
 // also allows). The same distribution; but a segment without a collision
 // costs a multiply and a compare instead of a random number and a logf, and
 // an octree walk hands out about two segments per lookup.
+// `uFirst`, when in [0, 1), is the uniform of the first arrival (a
+// low-discrepancy number); otherwise it is drawn from rng.
 template <typename Visit>
 MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
-                                                    PCG32& rng, TraceCounters& ctr, Visit visit) {
+                                                    PCG32& rng, TraceCounters& ctr, Visit visit,
+                                                    float uFirst = -1.f) {
   Ray indexRay;
   float t0, t1;
   if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
   MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, scale);
   RayMajorantSegment seg;
-  float tau = -logf(1.f - rng.Uniform());  // optical depth to the next arrival
+  float tau = -logf(1.f - (uFirst >= 0.f ? uFirst : rng.Uniform()));  // optical depth to the next arrival
   while (it.Next(&seg)) {
     ++ctr.majorantSegments;
     if (seg.sigma_maj <= 0.f) continue;
@@ -74,12 +77,16 @@ MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ra
 }
 
 // Delta tracking: a tentative collision is real with probability
-// sigma_t / sigma_maj.
+// sigma_t / sigma_maj. `first`, when given, holds the uniforms of the first
+// arrival and of its real-or-null choice (a low-discrepancy pair).
 MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
-                                               TraceCounters& ctr) {
+                                               TraceCounters& ctr, const float* first = nullptr) {
   FreePathResult r;
+  bool firstChoice = first != nullptr;
   SampleTentativeCollisions(s, ray, tMax, 1.f, rng, ctr, [&](float t, const Classification& c, float sigma_maj) {
-    if (rng.Uniform() * sigma_maj < c.sigma_t) {
+    const float u = firstChoice ? first[1] : rng.Uniform();
+    firstChoice = false;
+    if (u * sigma_maj < c.sigma_t) {
       ++ctr.realCollisions;
       r.collided = true;
       r.t = t;
@@ -88,14 +95,15 @@ MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ra
     }
     ++ctr.nullCollisions;
     return true;
-  });
+  }, first ? first[0] : -1.f);
   return r;
 }
 
 // Ratio tracking: transmittance along ray up to tMax, with sigma_t scaled by
-// `scale`, as the product of the null-collision probabilities.
+// `scale`, as the product of the null-collision probabilities. `uFirst` as
+// in SampleTentativeCollisions.
 MMRTM_CPU_GPU inline float RatioTrack(const SceneView& s, const Ray& ray, float tMax, float scale, PCG32& rng,
-                                      TraceCounters& ctr) {
+                                      TraceCounters& ctr, float uFirst = -1.f) {
   ++ctr.shadowRays;
   float T = 1.f;
   SampleTentativeCollisions(s, ray, tMax, scale, rng, ctr, [&](float, const Classification& c, float sigma_maj) {
@@ -108,7 +116,7 @@ MMRTM_CPU_GPU inline float RatioTrack(const SceneView& s, const Ray& ray, float 
       T /= kRatioSurvival;
     }
     return true;
-  });
+  }, uFirst);
   return T;
 }
 
@@ -151,16 +159,16 @@ MMRTM_CPU_GPU inline float RayMarchTransmittance(const SceneView& s, const Ray& 
 }
 
 MMRTM_CPU_GPU inline FreePathResult SampleFreePath(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
-                                                   TraceCounters& ctr) {
+                                                   TraceCounters& ctr, const float* first = nullptr) {
   return s.settings.estimator == Estimator::RayMarching ? RayMarch(s, ray, tMax, rng, ctr)
-                                                        : DeltaTrack(s, ray, tMax, rng, ctr);
+                                                        : DeltaTrack(s, ray, tMax, rng, ctr, first);
 }
 
 MMRTM_CPU_GPU inline float Transmittance(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
-                                         TraceCounters& ctr) {
+                                         TraceCounters& ctr, float uFirst = -1.f) {
   float scale = s.settings.shadowExtinctionScale;
   return s.settings.estimator == Estimator::RayMarching ? RayMarchTransmittance(s, ray, tMax, scale, rng, ctr)
-                                                        : RatioTrack(s, ray, tMax, scale, rng, ctr);
+                                                        : RatioTrack(s, ray, tMax, scale, rng, ctr, uFirst);
 }
 
 }  // namespace mmrtm
