@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Time to the error that 64 spp gave before issue 15, on the five reference
 scenes: the renderer as it was (one light chosen uniformly, uniform
-sampling), with next-event estimation by resampling (the default now), and
-with adaptive sampling on top.
+sampling, independent random numbers), with next-event estimation by
+resampling, with the Sobol' sampler on top (both the default now), and with
+adaptive sampling on top of that.
 
     Testing/Accuracy/time_to_error.py [--spp 64] [--repeats 2] [--only NAME ...]
         [--issue-binary OLD/bin/mmrtm-render]
@@ -37,9 +38,10 @@ import mmrtm_accuracy as acc
 SEED = 11  # not the references' seed
 
 METHODS = [
-    ("before: one light chosen, uniform", ["--light-sampling", "one"]),
-    ("resampled lights (default)", ["--light-sampling", "resampled"]),
-    ("resampled lights, adaptive sampling", ["--light-sampling", "resampled", "--sampling", "adaptive"]),
+    ("before: one light chosen, uniform, independent numbers", ["--light-sampling", "one", "--sampler", "independent"]),
+    ("resampled lights, independent numbers", ["--light-sampling", "resampled", "--sampler", "independent"]),
+    ("resampled lights, Sobol' pairs (default)", ["--light-sampling", "resampled", "--sampler", "sobol"]),
+    ("default, adaptive sampling", ["--light-sampling", "resampled", "--sampler", "sobol", "--sampling", "adaptive"]),
 ]
 
 

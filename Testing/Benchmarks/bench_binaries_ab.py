@@ -7,7 +7,7 @@ segments, density lookups) with the relative noise, which must agree for a
 change that only makes samples cheaper.
 
     .venv/bin/python Testing/Benchmarks/bench_binaries_ab.py A/bin/mmrtm-render B/bin/mmrtm-render \\
-        [--size 128] [--spp 32] [--repeats 3] [--only NAME ...]
+        [--size 128] [--spp 32] [--repeats 3] [--only NAME ...] [--b-option=--sampler --b-option=independent]
 
 Needs the shared data (MMRTM_SHARED_DATA_DIR or ../shared/data), not the references.
 """
@@ -29,6 +29,8 @@ def main():
     parser.add_argument("--spp", type=int, default=32)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
+    parser.add_argument("--b-option", action="append", default=[],
+                        help="an option for B only (repeat for several), e.g. one A does not have")
     args = parser.parse_args()
     print("| scene | A s | B s | A / B | segments per sample, A / B | lookups per sample, A / B | relative noise, A / B |")
     print("|---|---|---|---|---|---|---|")
@@ -37,7 +39,8 @@ def main():
         for _ in range(args.repeats):
             for key in ("a", "b"):
                 r = acc.render(acc.SCENES[name]["args"], args.size, args.size, args.spp, seed=3,
-                               extra=["--shadow-scale", "1"], binary=getattr(args, key))
+                               extra=["--shadow-scale", "1", *(args.b_option if key == "b" else [])],
+                               binary=getattr(args, key))
                 times[key].append(r.seconds)
                 stats[key] = r.stats
         ta, tb = statistics.median(times["a"]), statistics.median(times["b"])
