@@ -69,7 +69,8 @@ options:
                         (a pilot pass, then each pixel's share of a mean of --spp
                         in proportion to its neighbours' noise; unbiased)
   --sampler S           sobol (Owen-scrambled Sobol' numbers for the pixel, lens and
-                        first scattering; default) or independent (all from PCG32)
+                        first two scattering events; default) or independent (all
+                        from PCG32)
   --seed S              random seed (default: scene, else 0)
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),

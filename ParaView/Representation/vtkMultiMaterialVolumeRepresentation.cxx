@@ -82,6 +82,11 @@ void vtkMultiMaterialVolumeRepresentation::SetAccelerator(int accelerator)
   this->Mapper()->SetAccelerator(accelerator);
 }
 
+void vtkMultiMaterialVolumeRepresentation::SetSampler(int sampler)
+{
+  this->Mapper()->SetSampler(sampler);
+}
+
 void vtkMultiMaterialVolumeRepresentation::SetBackend(int backend)
 {
   this->Mapper()->SetBackend(backend);

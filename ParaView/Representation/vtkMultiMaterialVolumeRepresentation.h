@@ -86,6 +86,7 @@ public:
    * 0 octree (the paper's hierarchical grid), 1 macrocells, 2 none.
    */
   void SetAccelerator(int accelerator);
+  void SetSampler(int sampler);
 
   /**
    * 0 automatic, 1 CPU, 2 CUDA.

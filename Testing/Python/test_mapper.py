@@ -514,6 +514,14 @@ class MapperTest(unittest.TestCase):
         self.assertGreater(coverage(global_majorant), 0.05)
         self.assertGreater(other_seed, 0.0)
         self.assertLess(mean_abs_difference(octree, global_majorant), 1.5 * other_seed)
+        # So are both samplers (Sobol' pairs by default, or independent
+        # numbers): other numbers, the same image up to noise.
+        self.assertEqual(s.mapper.GetSampler(), s.mapper.SOBOL)
+        s.mapper.SetAcceleratorToOctree()
+        s.mapper.SetSamplerToIndependent()
+        independent = converged()
+        self.assertNotEqual(independent, octree)
+        self.assertLess(mean_abs_difference(octree, independent), 1.5 * other_seed)
 
     def test_asynchronous_refinement_gives_the_same_image(self):
         import time

@@ -661,6 +661,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       rs.integrator.seed = static_cast<uint64_t>(this->Seed);
       rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
       rs.integrator.maxBounces = this->MaximumBounces;
+      rs.integrator.sampler =
+        this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
       rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
         : this->Accelerator == NO_ACCELERATOR             ? mmrtm::MajorantKind::Global
                                                           : mmrtm::MajorantKind::Octree;
@@ -1053,6 +1055,7 @@ void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ShadowExtinctionScale: " << this->ShadowExtinctionScale << "\n";
   os << indent << "NoiseTarget: " << this->NoiseTarget << "\n";
   os << indent << "Accelerator: " << this->Accelerator << "\n";
+  os << indent << "Sampler: " << (this->Sampler == INDEPENDENT ? "independent" : "sobol") << "\n";
   os << indent << "MaximumBounces: " << this->MaximumBounces << "\n";
   os << indent << "AccumulatedSamples: " << this->GetAccumulatedSamples() << "\n";
 }

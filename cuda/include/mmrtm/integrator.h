@@ -225,8 +225,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
 
 // One sample of pixel (x, y): its own random stream (DESIGN.md rule 2), a
 // box-filtered position in the pixel, a lens position, and the path; with
-// the Sobol' sampler the first two and the first vertex's numbers are
-// Owen-scrambled Sobol' pairs of the same (seed, pixel, sample index).
+// the Sobol' sampler the position, the lens and the first vertices' numbers
+// are Owen-scrambled Sobol' pairs of the same (seed, pixel, sample index).
 MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, int y, uint32_t sampleIndex,
                                                    TraceCounters& ctr) {
   const uint64_t pixel = (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y;

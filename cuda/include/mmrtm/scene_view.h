@@ -30,7 +30,7 @@ enum class LightSampling {
 enum class PixelSampler : uint8_t {
   Independent,  // every number from the sample's PCG32 stream
   Sobol         // Owen-scrambled Sobol' pairs for the pixel, the lens and the
-                // first vertex (the default); the rest from the stream
+                // first two vertices (the default); the rest from the stream
 };
 
 struct IntegratorSettings {

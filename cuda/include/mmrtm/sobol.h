@@ -83,6 +83,8 @@ class SobolPairs {
   // Pair `pair`, uniform on [0, 1)^2.
   MMRTM_CPU_GPU void Get(int pair, float* u0, float* u1) const {
     const uint64_t h = MixBits(key_ + (uint64_t)(pair + 1) * 0x9e3779b97f4a7c15ULL);
+    // Burley's shuffle: the index Owen-scrambled (as a fraction, whose
+    // reversed bits are the index's), so bit k flips by the bits above it.
     const uint32_t index = OwenScrambleReversed(reversedIndex_, (uint32_t)MixBits(h));
     *u0 = FractionToFloat(OwenScrambleReversed(index, (uint32_t)h));
     *u1 = FractionToFloat(OwenScrambleReversed(SobolDimension1Reversed(index), (uint32_t)(h >> 32)));
