@@ -28,7 +28,11 @@ json Classes() {
 }
 
 LabelTable Table() {
-  const std::string path = std::string(MMRTM_TEST_OUTPUT_DIR) + "/label_materials_table.txt";
+  // A file per test: CTest runs the tests of this file as parallel
+  // processes, and one that rewrote a shared file while another read it
+  // left the reader an empty table (seen once in a -j2 run).
+  const std::string path = std::string(MMRTM_TEST_OUTPUT_DIR) + "/label_materials_table_" +
+                           ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
   std::ofstream(path) << "# test\n1 aorta\n2 vertebrae_T12 255 0 0\n3 liver 0 255 0 255\n";
   return ReadLabelTable(path);
 }
