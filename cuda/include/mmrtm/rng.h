@@ -19,6 +19,13 @@ MMRTM_CPU_GPU inline uint64_t MixBits(uint64_t v) {
   return v;
 }
 
+// A float in [0, 1) from 32 random bits (their top 24, which a float holds
+// exactly); also the Sobol' numbers' conversion (mmrtm/sobol.h).
+MMRTM_CPU_GPU inline float UniformFloat(uint32_t bits) {
+  const float u = (float)(bits >> 8) * 0x1p-24f;
+  return u < kOneMinusEpsilon ? u : kOneMinusEpsilon;
+}
+
 class PCG32 {
  public:
   MMRTM_CPU_GPU PCG32() { SetSequence(0, 0x853c49e6748fea9bULL); }
@@ -42,10 +49,7 @@ class PCG32 {
   }
 
   // Uniform float in [0, 1).
-  MMRTM_CPU_GPU float Uniform() {
-    float u = (float)(NextU32() >> 8) * 0x1p-24f;
-    return u < kOneMinusEpsilon ? u : kOneMinusEpsilon;
-  }
+  MMRTM_CPU_GPU float Uniform() { return UniformFloat(NextU32()); }
 
  private:
   uint64_t state_, inc_;

@@ -68,11 +68,6 @@ MMRTM_CPU_GPU inline uint32_t OwenScrambleReversed(uint32_t v, uint32_t seed) {
   return ReverseBits32(v);
 }
 
-MMRTM_CPU_GPU inline float FractionToFloat(uint32_t v) {
-  const float u = (float)(v >> 8) * 0x1p-24f;
-  return u < kOneMinusEpsilon ? u : kOneMinusEpsilon;
-}
-
 // The low-discrepancy pairs of one pixel sample, computed when asked for.
 class SobolPairs {
  public:
@@ -86,8 +81,8 @@ class SobolPairs {
     // Burley's shuffle: the index Owen-scrambled (as a fraction, whose
     // reversed bits are the index's), so bit k flips by the bits above it.
     const uint32_t index = OwenScrambleReversed(reversedIndex_, (uint32_t)MixBits(h));
-    *u0 = FractionToFloat(OwenScrambleReversed(index, (uint32_t)h));
-    *u1 = FractionToFloat(OwenScrambleReversed(SobolDimension1Reversed(index), (uint32_t)(h >> 32)));
+    *u0 = UniformFloat(OwenScrambleReversed(index, (uint32_t)h));
+    *u1 = UniformFloat(OwenScrambleReversed(SobolDimension1Reversed(index), (uint32_t)(h >> 32)));
   }
 
  private:
