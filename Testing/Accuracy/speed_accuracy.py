@@ -4,6 +4,7 @@ samples per pixel, for delta tracking with each accelerator and for ray
 marching at several step sizes, on every reference scene.
 
     Testing/Accuracy/speed_accuracy.py [--max-spp N] [--only NAME ...]
+        [--issue-binary OLD/bin/mmrtm-render]
 
 Needs the references of make_references.py. Writes
 Documentation/images/speed_accuracy_NAME.png and the numbers to
@@ -13,6 +14,11 @@ reference's relative noise is drawn as a dotted line. A third panel takes the
 measured render's own variance out as well: what remains is its bias (about
 0 for the unbiased estimators, a plateau for ray marching). Every render uses the
 unbiased shadow rays (--shadow-scale 1), as the references do.
+
+With --issue-binary (a build of c669328, the commit issue 15 was filed on;
+time_to_error.py's help says how to build it), that renderer is drawn too,
+as "before", and the table's speed-ups are against it; without it, against
+today's octree with one light chosen uniformly and independent numbers.
 """
 
 import argparse
@@ -26,15 +32,18 @@ import matplotlib.pyplot as plt  # noqa: E402
 import mmrtm_accuracy as acc  # noqa: E402
 
 SEED = 7  # differs from make_references.REFERENCE_SEED: independent noise
-BEFORE = "delta, octree, one light chosen (before)"
+ISSUE_BUILD = "when issue 15 was filed (c669328)"
+ONE_LIGHT = "delta, octree, one light chosen, independent numbers"
+DEFAULT = "delta, octree (default)"
 
 METHODS = [
     # label, options, colour, line style
     ("delta, no accelerator", ["--accelerator", "none"], "tab:gray", "-"),
     ("delta, macrocell", ["--accelerator", "macrocell"], "tab:blue", "-"),
-    ("delta, octree (default)", ["--accelerator", "octree"], "tab:green", "-"),
-    # Before issue 15's changes to next-event estimation: one light chosen uniformly.
-    (BEFORE, ["--accelerator", "octree", "--light-sampling", "one"], "black", "-."),
+    (DEFAULT, ["--accelerator", "octree"], "tab:green", "-"),
+    # The estimator of before issue 15's changes to next-event estimation and
+    # sampling (one light chosen uniformly, independent numbers), on today's code.
+    (ONE_LIGHT, ["--accelerator", "octree", "--light-sampling", "one", "--sampler", "independent"], "black", "-."),
     ("delta, octree, adaptive sampling", ["--accelerator", "octree", "--sampling", "adaptive"], "tab:cyan", "-"),
     ("delta, octree-voxelmax", ["--accelerator", "octree-voxelmax"], "tab:olive", "--"),
     ("ray marching 2 mm", ["--estimator", "raymarch", "--ray-march-step", "2"], "tab:red", ":"),
@@ -44,7 +53,24 @@ METHODS = [
 ]
 
 
-def measure(name, max_spp, size, budget):
+def methods(issue_binary):
+    """(label, options, colour, style, binary): METHODS, and first the build
+    issue 15 was filed on when given."""
+    rows = [(label, options, colour, style, None) for label, options, colour, style in METHODS]
+    if issue_binary:
+        rows.insert(0, (ISSUE_BUILD, [], "magenta", "-.", issue_binary))
+    return rows
+
+
+def before_label(result):
+    """The method the speed-ups are against: the issue's build if it was measured."""
+    for label in (ISSUE_BUILD, ONE_LIGHT, DEFAULT):
+        if result["methods"].get(label):
+            return label
+    raise KeyError("no method to compare with")
+
+
+def measure(name, max_spp, size, budget, issue_binary=None):
     ref = acc.load_reference(name)
     if ref is None:
         raise SystemExit(f"no reference for {name} in {acc.REFERENCE_DIR}: run make_references.py first")
@@ -55,11 +81,11 @@ def measure(name, max_spp, size, budget):
               "methods": {}}
     ladder = [s for s in (1, 2, 4, 8, 16, 32, 64, 128, 256, 512) if s <= max_spp]
     # Every method doubles its samples up to max_spp, or until one render would exceed the time budget.
-    for label, options, _, _ in METHODS:
+    for label, options, _, _, binary in methods(issue_binary):
         rows = []
         for spp in ladder:
             r = acc.render(acc.SCENES[name]["args"], size, size, spp, seed=SEED,
-                           extra=["--shadow-scale", "1", *options])
+                           extra=["--shadow-scale", "1", *options], binary=binary)
             rows.append({"spp": spp, "seconds": r.seconds,
                          "rel_rmse": acc.relative_rmse(r.mean, ref_mean, ref_var),
                          # The render's own noise taken out as well: what is left is its bias.
@@ -77,7 +103,7 @@ def measure(name, max_spp, size, budget):
 
 def chart(name, result, path):
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.4))
-    for label, _, colour, style in METHODS:
+    for label, _, colour, style, _ in methods(ISSUE_BUILD in result["methods"]):
         rows = result["methods"].get(label)
         if not rows:
             continue
@@ -111,15 +137,16 @@ def chart(name, result, path):
 
 def table(results):
     """Markdown: per scene and method, the last measured rung, and the time each
-    method needs to reach the error of the renderer before issue 15 (one light
-    chosen uniformly, octree) at its last rung (64 spp): t e^2 / e0^2, valid
+    method needs to reach the error of the renderer before issue 15 (its build,
+    or else one light chosen uniformly and independent numbers on the octree)
+    at its last rung (64 spp): t e^2 / e0^2, valid
     while the error is still falling as 1 / sqrt(samples); a method whose
     error has stopped falling above that error never reaches it."""
     lines = ["| scene | method | spp | render s | rel. RMSE | rel. bias | time to before's error | speed-up |",
              "|---|---|---|---|---|---|---|---|"]
     for name, result in results.items():
-        target = result["methods"].get(BEFORE, result["methods"]["delta, octree (default)"])[-1]
-        for label, _, _, _ in METHODS:
+        target = result["methods"][before_label(result)][-1]
+        for label, _, _, _, _ in methods(ISSUE_BUILD in result["methods"]):
             rows = result["methods"].get(label)
             if not rows:
                 continue
@@ -144,12 +171,13 @@ def main():
                         help="seconds: a method's samples stop doubling before one render would take longer")
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     parser.add_argument("--charts-only", action="store_true", help="redraw from speed_accuracy.json")
+    parser.add_argument("--issue-binary", help="mmrtm-render built at the commit issue 15 was filed on")
     args = parser.parse_args()
     store = acc.REFERENCE_DIR / "speed_accuracy.json"
     results = json.loads(store.read_text()) if store.exists() else {}
     for name in args.only or list(acc.SCENES):
         if not args.charts_only:
-            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE, args.budget)
+            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE, args.budget, args.issue_binary)
             store.write_text(json.dumps(results, indent=1))
         if name in results:
             chart(name, results[name], acc.DOC_IMAGES / f"speed_accuracy_{name}.png")

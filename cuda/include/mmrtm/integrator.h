@@ -88,12 +88,12 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     if (!fp.collided) {
       if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
-        RGB Le = s.environment.Le(ray.d);
         if (depth == 0) {
-          if (s.settings.backgroundVisible) out.L += beta * Le;
+          if (s.settings.backgroundVisible) out.L += beta * s.environment.Le(ray.d);
         } else {
-          float w = PowerHeuristic(scatterPdf, lightSelectPdf * s.environment.Pdf(ray.d));
-          out.L += beta * Le * w;
+          float lightPdf;
+          RGB Le = s.environment.LeAndPdf(ray.d, &lightPdf);
+          out.L += beta * Le * PowerHeuristic(scatterPdf, lightSelectPdf * lightPdf);
         }
       }
       break;

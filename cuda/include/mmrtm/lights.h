@@ -24,25 +24,40 @@ struct EnvironmentView {
     *u = Clamp(phi * kInv2Pi, 0.f, kOneMinusEpsilon);
     *v = Clamp(acosf(Clamp(w.z, -1.f, 1.f)) * kInvPi, 0.f, kOneMinusEpsilon);
   }
-  MMRTM_CPU_GPU static Vec3 UVToDirection(float u, float v) {
+  // The direction of (u, v); `sinTheta`, when given, the sine of its polar
+  // angle (the Jacobian's factor).
+  MMRTM_CPU_GPU static Vec3 UVToDirection(float u, float v, float* sinTheta = nullptr) {
     float phi = u * 2.f * kPi, theta = v * kPi;
     float s = sinf(theta);
+    if (sinTheta) *sinTheta = s;
     return {s * cosf(phi), s * sinf(phi), cosf(theta)};
   }
+  // Solid-angle pdf from the (u, v) pdf, at a polar angle of sine sinTheta.
+  MMRTM_CPU_GPU static float SolidAnglePdf(float pdfUV, float sinTheta) {
+    return sinTheta > 0.f ? pdfUV / (2.f * kPi * kPi * sinTheta) : 0.f;
+  }
 
+  MMRTM_CPU_GPU RGB Texel(float u, float v) const {
+    int x = ClampInt((int)(u * width), 0, width - 1), y = ClampInt((int)(v * height), 0, height - 1);
+    return texels[x + width * y];
+  }
   MMRTM_CPU_GPU RGB Le(Vec3 w) const {
     float u, v;
     DirectionToUV(w, &u, &v);
-    int x = ClampInt((int)(u * width), 0, width - 1), y = ClampInt((int)(v * height), 0, height - 1);
-    return texels[x + width * y];
+    return Texel(u, v);
   }
   // Solid-angle pdf of sampling direction w.
   MMRTM_CPU_GPU float Pdf(Vec3 w) const {
     float u, v;
     DirectionToUV(w, &u, &v);
-    float sinTheta = sinf(v * kPi);
-    if (sinTheta <= 0.f) return 0.f;
-    return distribution.Pdf(u, v) / (2.f * kPi * kPi * sinTheta);
+    return SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi));
+  }
+  // Le(w) and Pdf(w) from one conversion of w to (u, v).
+  MMRTM_CPU_GPU RGB LeAndPdf(Vec3 w, float* pdf) const {
+    float u, v;
+    DirectionToUV(w, &u, &v);
+    *pdf = SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi));
+    return Texel(u, v);
   }
 };
 
@@ -79,15 +94,18 @@ MMRTM_CPU_GPU inline LightSample SampleLight(const Light& light, const Environme
       break;
     }
     case LightType::Environment: {
-      float u, v, pdfUV;
-      env.distribution.Sample(u0, u1, &u, &v, &pdfUV);
-      if (pdfUV <= 0.f) return s;  // pdf 0: no sample
-      s.wi = EnvironmentView::UVToDirection(u, v);
-      s.L = env.Le(s.wi);
-      // The pdf as Pdf(wi) computes it, so that the MIS weights of light and
-      // BSDF sampling use one function and sum to one (they could differ by
-      // a texel where the direction round trip crosses a texel edge).
-      s.pdf = env.Pdf(s.wi);
+      float u, v, pdfUV, sinTheta;
+      int col, row;
+      env.distribution.Sample(u0, u1, &u, &v, &pdfUV, &col, &row);
+      s.wi = EnvironmentView::UVToDirection(u, v, &sinTheta);
+      // The radiance and pdf of the texel that was sampled (the distribution
+      // is over the texels), not of wi converted back to (u, v): that round
+      // trip cost an atan2f, an acosf and a sinf twice per light sample, and
+      // lands in the same texel but where float rounding crosses a texel
+      // edge, a set of directions of measure zero.
+      s.pdf = EnvironmentView::SolidAnglePdf(pdfUV, sinTheta);
+      if (s.pdf <= 0.f) return s;  // pdf 0: no sample
+      s.L = env.texels[col + env.width * row];
       s.isDelta = false;
       break;
     }

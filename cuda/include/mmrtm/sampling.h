@@ -77,12 +77,16 @@ struct Distribution2DView {
   Distribution1DView marginal;                      // over v
   int nu = 0, nv = 0;
 
-  MMRTM_CPU_GPU void Sample(float u0, float u1, float* u, float* v, float* pdf) const {
+  // (u, v) with its pdf; `col` and `row`, when given, the bucket it fell in.
+  MMRTM_CPU_GPU void Sample(float u0, float u1, float* u, float* v, float* pdf, int* col = nullptr,
+                            int* row = nullptr) const {
     float pdfV, pdfU;
-    int row, col;
-    *v = marginal.Sample(u1, &pdfV, &row);
-    *u = conditional[row].Sample(u0, &pdfU, &col);
+    int r, c;
+    *v = marginal.Sample(u1, &pdfV, &r);
+    *u = conditional[r].Sample(u0, &pdfU, &c);
     *pdf = pdfU * pdfV;
+    if (col) *col = c;
+    if (row) *row = r;
   }
   MMRTM_CPU_GPU float Pdf(float u, float v) const {
     int iu = ClampInt((int)(u * nu), 0, nu - 1), iv = ClampInt((int)(v * nv), 0, nv - 1);
