@@ -11,7 +11,8 @@ py=../../.venv/bin/python
 mkdir -p ../../build/references
 log() { echo "== $* ($(date +%H:%M:%S))" >&2; }
 log "references";            "$py" make_references.py --spp "${REFERENCE_SPP:-2048}"
-log "speed against accuracy"; "$py" speed_accuracy.py
+# MMRTM_ISSUE15_RENDER: a build of c669328 (time_to_error.py's help), drawn as "before".
+log "speed against accuracy"; "$py" speed_accuracy.py ${MMRTM_ISSUE15_RENDER:+--issue-binary "$MMRTM_ISSUE15_RENDER"}
 log "Mitsuba 3 check";       "$py" mitsuba_check.py --save ../../build/references/mitsuba | tee ../../build/references/mitsuba.log
 log "noise target";          "$py" noise_target_check.py --json ../../build/references/noise_target.json
 log "failure cases";         "$py" failure_charts.py

@@ -55,7 +55,8 @@ METHODS = [
 
 def methods(issue_binary):
     """(label, options, colour, style, binary): METHODS, and first the build
-    issue 15 was filed on when given."""
+    issue 15 was filed on when `issue_binary` is given (its path; the charts
+    and the table pass True when stored results have it)."""
     rows = [(label, options, colour, style, None) for label, options, colour, style in METHODS]
     if issue_binary:
         rows.insert(0, (ISSUE_BUILD, [], "magenta", "-.", issue_binary))

@@ -105,6 +105,7 @@ MMRTM_CPU_GPU inline LightSample SampleLight(const Light& light, const Environme
       // edge, a set of directions of measure zero.
       s.pdf = EnvironmentView::SolidAnglePdf(pdfUV, sinTheta);
       if (s.pdf <= 0.f) return s;  // pdf 0: no sample
+      MMRTM_DCHECK(env.distribution.nu == env.width && env.distribution.nv == env.height);  // a bucket per texel
       s.L = env.texels[col + env.width * row];
       s.isDelta = false;
       break;
