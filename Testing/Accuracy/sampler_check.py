@@ -16,11 +16,7 @@ the time to an equal error scales as time x error^2: the speed-up is
 """
 
 import argparse
-import json
 import statistics
-import subprocess
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
@@ -41,14 +37,10 @@ def errors(name, ref, spp, seeds):
 
 def seconds_per_render(name, turns=4):
     times = {s: [] for s in SAMPLERS}
-    with tempfile.TemporaryDirectory() as tmp:
-        stats = Path(tmp) / "stats.json"
-        for _ in range(turns):
-            for sampler in SAMPLERS:
-                subprocess.run([str(acc.RENDER), *acc.SCENES[name]["args"], "--width", "128", "--height", "128",
-                                "--spp", "32", "--threads", "1", "--quiet", "--sampler", sampler,
-                                "--output", str(Path(tmp) / "out.png"), "--stats-json", str(stats)], check=True)
-                times[sampler].append(json.loads(stats.read_text())["seconds"]["render"])
+    for _ in range(turns):
+        for sampler in SAMPLERS:
+            r = acc.render(acc.SCENES[name]["args"], 128, 128, 32, extra=["--threads", "1", "--sampler", sampler])
+            times[sampler].append(r.seconds)
     return {s: statistics.median(t) for s, t in times.items()}
 
 
