@@ -282,32 +282,55 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// Uniform sampling. With a noise target the samples come in passes that
-// double up to 64 spp (a pass's cost is mostly its samples: each checks the
-// noise once), and rendering stops after the first pass whose image meets
-// the target. The passes continue one sample sequence, so the image equals
-// the one rendered in one go with as many samples. Returns whether the
-// target was reached.
+// The size of the next pass towards a noise target, after `done` samples
+// per pixel (the mean, with adaptive sampling) whose image has relative
+// noise `noise`. The noise falls as 1 / sqrt(samples), so the target needs
+// done (noise / target)^2 in all; 5 % more makes the check after the pass
+// pass rather than ask for one more small pass. At least 4 samples, an even
+// number (Film::Noise's two replicates stay the same size), at most twice
+// what was done and 64: an estimate from few samples may be off (Sobol'
+// samples converge faster than 1 / sqrt, which only makes it overshoot),
+// and a pass is the step of the progress bar and of cancelling.
+int NextPassTowards(double noiseTarget, double noise, double done) {
+  const double ratio = noise / noiseTarget;
+  const double missing = std::ceil(done * ratio * ratio * 1.05 - done);
+  const int most = (int)std::min(2.0 * done, 64.0);
+  const int pass = (int)std::clamp(missing, 4.0, (double)std::max(most, 4));
+  return pass + (pass & 1);
+}
+
+// Uniform sampling. With a noise target the samples come in passes, 4 and
+// then as many as the last noise says the target needs (NextPassTowards;
+// a pass's cost is mostly its samples: each checks the noise once), and
+// rendering stops after the first pass whose image meets the target. The
+// passes continue one sample sequence, so the image equals the one
+// rendered in one go with as many samples. Returns whether the target was
+// reached.
 bool RenderUniformly(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, const mmrtm::SceneView& view,
                      mmrtm::Film& film, int spp, double noiseTarget, mmrtm::TraceCounters& counters,
                      ProgressBar& bar) {
   int pass = noiseTarget > 0 ? 4 : spp;
-  for (int done = 0; done < spp; done += pass, pass = std::min(2 * pass, 64)) {
+  for (int done = 0; done < spp;) {
     pass = std::min(pass, spp - done);
     renderer.Render(scene, view, film, pass, &counters, [&](int d, int t) {
       bar((int)(1000.0 * (done + pass * (double)d / t) / spp), 1000);
     });
-    if (noiseTarget > 0 && film.Samples() >= 2 && film.Noise().relative <= noiseTarget) return true;
+    done += pass;
+    if (noiseTarget > 0 && film.Samples() >= 2) {
+      const double noise = film.Noise().relative;
+      if (noise <= noiseTarget) return true;
+      pass = NextPassTowards(noiseTarget, noise, done);
+    }
   }
   return false;
 }
 
 // Adaptive sampling (adaptive_sampling.h): a uniform pilot pass (4 spp with
 // a noise target, else spp / 8 up to 8), then passes that bring the mean to
-// spp, or with a noise target to 8, 16, 32, 64 and then 64 more each, until
-// the target is met. Every pass splits its mean by the pilot's weights, so
-// a pixel's count never depends on its own samples. A pixel gets at most 16
-// times the mean.
+// spp, or with a noise target to the mean that the last noise says the
+// target needs (NextPassTowards), until the target is met. Every pass
+// splits its mean by the pilot's weights, so a pixel's count never depends
+// on its own samples. A pixel gets at most 16 times the mean.
 bool RenderAdaptively(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, const mmrtm::SceneView& view,
                       mmrtm::Film& film, int spp, double noiseTarget, mmrtm::TraceCounters& counters,
                       ProgressBar& bar) {
@@ -315,17 +338,21 @@ bool RenderAdaptively(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, cons
   film.TrackWork();
   renderer.Render(scene, view, film, pilot, &counters,
                   [&](int d, int t) { bar((int)(1000.0 * pilot * d / t / spp), 1000); });
-  if (noiseTarget > 0 && film.Noise().relative <= noiseTarget) return true;
+  double noise = noiseTarget > 0 ? film.Noise().relative : 0.0;
+  if (noiseTarget > 0 && noise <= noiseTarget) return true;
   const std::vector<float> weights = mmrtm::AdaptiveSampleWeights(film);
   for (double mean = pilot; mean < spp;) {
     const double before = film.MeanSamples();
-    mean = noiseTarget > 0 ? std::min<double>(spp, std::min(2 * mean, mean + 64)) : spp;
+    mean = noiseTarget > 0 ? std::min<double>(spp, mean + NextPassTowards(noiseTarget, noise, mean)) : spp;
     const std::vector<uint32_t> counts =
         mmrtm::AdaptiveSampleCounts(film, weights, mean, (uint32_t)std::min(16.0 * mean, 1e9));
     renderer.RenderTo(scene, view, film, counts, &counters, [&](int d, int t) {
       bar((int)(1000.0 * (before + (mean - before) * d / t) / spp), 1000);
     });
-    if (noiseTarget > 0 && film.Noise().relative <= noiseTarget) return true;
+    if (noiseTarget > 0) {
+      noise = film.Noise().relative;
+      if (noise <= noiseTarget) return true;
+    }
   }
   return false;
 }

@@ -79,6 +79,9 @@ TEST(GpuBackend, ImageMatchesTheCpuImageOfTheSameSeed) {
   renderer.Render(gpu, 16, &gpuCounters);
   EXPECT_GE(ClosePixels(cpu, gpu), 96 * 96 * 99 / 100) << "pixels equal to float tolerance";
   EXPECT_LT(MeanSquaredZScore(cpu, gpu), 0.1);
+  // The even samples' mean luminance comes back from the device too.
+  EXPECT_NEAR(gpu.Noise().relative, cpu.Noise().relative, 0.02 * cpu.Noise().relative);
+  EXPECT_GT(cpu.Noise().relative, 0.0);
   EXPECT_EQ(gpuCounters.paths, cpuCounters.paths);
   EXPECT_EQ(gpuCounters.majorantViolations, 0u);
 }
@@ -101,6 +104,7 @@ TEST(GpuBackend, AccumulationContinuesOnTheDevice) {
   for (size_t i = 0; i < a.pixels.size(); ++i)
     for (int c = 0; c < 3; ++c) differ += a.pixels[i][c] != b.pixels[i][c];
   EXPECT_EQ(differ, 0);
+  EXPECT_EQ(twice.Noise().relative, once.Noise().relative);
 }
 
 // Adaptive sampling on the device: per-pixel counts give the CPU's image
@@ -131,6 +135,7 @@ TEST(GpuBackend, PerPixelCountsMatchTheCpu) {
       workGpu += gpu.Work(x, y);
     }
   EXPECT_GE(ClosePixels(cpu, gpu), 64 * 64 * 99 / 100) << "pixels equal to float tolerance";
+  EXPECT_NEAR(gpu.Noise().relative, cpu.Noise().relative, 0.02 * cpu.Noise().relative);
   EXPECT_GT(workCpu, 0.0);
   EXPECT_NEAR(workGpu, workCpu, 0.01 * workCpu);
 }

@@ -81,7 +81,8 @@ public:
   /**
    * Relative noise of the accumulated image (Film noise: the root mean
    * square standard error of the pixels' luminance over their mean
-   * luminance) at which Render() stops adding samples, as it does at
+   * luminance, measured by the difference between each pixel's even and
+   * odd samples) at which Render() stops adding samples, as it does at
    * MaximumSamples; 0 (the default) has no noise target.
    */
   vtkSetClampMacro(NoiseTarget, double, 0.0, 1.0);
@@ -152,10 +153,11 @@ public:
    * Owen-scrambled Sobol' pairs for the pixel position and the first two
    * scattering events, which reach a given error 1.1-1.26 times sooner) or
    * INDEPENDENT (every number from the sample's random stream). Both are
-   * unbiased; with SOBOL, GetRelativeNoise() overstates the error (by 13-20 %
-   * on the tracer's reference scenes), because a pixel's samples are
-   * stratified, so statistical tests that take it for the error use
-   * INDEPENDENT.
+   * unbiased, and GetRelativeNoise() is the error of either: it compares a
+   * pixel's even samples with its odd ones, two independently scrambled
+   * nets. (A pixel's own sample variance, which the z-score tests of the
+   * mapper use, overstates a SOBOL image's error by 13-20 %: those tests
+   * use INDEPENDENT.)
    */
   vtkSetClampMacro(Sampler, int, SOBOL, INDEPENDENT);
   vtkGetMacro(Sampler, int);

@@ -70,19 +70,22 @@ struct GpuRenderer::Impl {
   float* majorants = nullptr;        // inside `tables`
   size_t majorantCount = 0;
   DeviceBuffer summaries[kMaxProxies], binMax, binMaterials;
-  DeviceBuffer filmMean, filmM2, filmWork, counters, rangeFirst, rangeEnd;
+  DeviceBuffer filmMean, filmM2, filmEven, filmWork, counters, rangeFirst, rangeEnd;
   int filmWidth = 0, filmHeight = 0;
   uint32_t filmSamples = 0;
   bool filmUniform = true;  // false after RenderTo: the next Render uploads the film
   bool hasWork = false;     // the device film has per-pixel work (Film::TrackWork)
 
-  // Puts the host film on the device (mean, M2, and work when tracked).
+  // Puts the host film on the device (mean, M2, the even samples' mean
+  // luminance, and work when tracked).
   void UploadFilm(const FilmView& host) {
     const size_t pixels = (size_t)host.width * host.height;
     filmMean.Allocate(pixels * 4 * sizeof(float), "the film");
     filmM2.Allocate(pixels * 3 * sizeof(float), "the film");
+    filmEven.Allocate(pixels * sizeof(float), "the film");
     filmMean.Upload(host.mean, pixels * 4 * sizeof(float));
     filmM2.Upload(host.m2, pixels * 3 * sizeof(float));
+    filmEven.Upload(host.evenLuminance, pixels * sizeof(float));
     filmWork = DeviceBuffer();
     if (host.work) {
       filmWork.Allocate(pixels * sizeof(float), "the film");
@@ -94,12 +97,13 @@ struct GpuRenderer::Impl {
   }
   FilmView DeviceFilm() {
     return FilmView{filmWidth, filmHeight, filmMean.As<float>(), filmM2.As<float>(),
-                    hasWork ? filmWork.As<float>() : nullptr};
+                    hasWork ? filmWork.As<float>() : nullptr, filmEven.As<float>()};
   }
   void DownloadFilm(const FilmView& host) const {
     const size_t pixels = (size_t)host.width * host.height;
     filmMean.Download(host.mean, pixels * 4 * sizeof(float));
     filmM2.Download(host.m2, pixels * 3 * sizeof(float));
+    filmEven.Download(host.evenLuminance, pixels * sizeof(float));
     if (host.work) filmWork.Download(host.work, pixels * sizeof(float));
   }  // Renders sample indices [from, to) of every pixel, or with per-pixel
   // ranges [first, end) of the pixels whose range holds them; one launch

@@ -11,9 +11,11 @@ Film::Film(int width, int height) : width_(width), height_(height) { Reset(); }
 
 void Film::Reset() {
   samples_ = 0;
+  combinedEvenSamples_ = 0;
   pixelSamples_.clear();
   mean_.assign((size_t)width_ * height_ * 4, 0.f);
   m2_.assign((size_t)width_ * height_ * 3, 0.f);
+  evenLuminance_.assign((size_t)width_ * height_, 0.f);
   if (!work_.empty()) TrackWork();
 }
 
@@ -57,22 +59,24 @@ RGB Film::VarianceOfMean(int x, int y) const {
 NoiseEstimate Film::Noise() const {
   NoiseEstimate e;
   double sumL = 0, sumVar = 0;
-  const double w[3] = {0.2126, 0.7152, 0.0722};
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
-      sumL += Luminance(Mean(x, y));
-      const RGB v = VarianceOfMean(x, y);
-      // The film keeps no covariances between channels. The luminance's
-      // standard error is at most the weighted sum of the channels' own
-      // (Cauchy-Schwarz), equal to it when the channels move together, as
-      // they nearly do in a path tracer (one path carries all three). Summing
-      // variances as if independent made the noise 1.3-1.4 times smaller
-      // than the error against a reference (noise_target_check.py), so a
-      // noise target stopped too early; this bound does not.
-      // (max: a combined film's rounding can leave a variance just below 0.)
-      auto sd = [](float var) { return std::sqrt(std::max(0.0, (double)var)); };
-      const double se = w[0] * sd(v.r) + w[1] * sd(v.g) + w[2] * sd(v.b);
-      sumVar += se * se;
+      const double L = Luminance(Mean(x, y));
+      sumL += L;
+      // The even samples' mean m0 (n0 of them) and the odd ones' m1 (n1)
+      // are independent estimates of the pixel (two independently
+      // scrambled nets, or independent numbers), so E[(m0 - m1)^2] =
+      // Var m0 + Var m1, and (m0 - m1)^2 n0 n1 / n^2 estimates the variance
+      // of the whole mean without bias (exactly for n0 = n1; for odd n where
+      // each replicate's variance goes as 1 / its samples). Luminance
+      // directly: no bound on the channels' covariance is needed. The
+      // samples' own spread (VarianceOfMean) would overstate a stratified
+      // mean's error by 13-20 % (noise_target_check.py), so a target would
+      // stop later than it needs to.
+      const uint32_t n = PixelSamples(x, y), n0 = EvenSamples(n), n1 = n - n0;
+      if (n0 == 0 || n1 == 0) continue;
+      const double m0 = evenLuminance_[(size_t)y * width_ + x], m1 = ((double)n * L - (double)n0 * m0) / n1;
+      sumVar += (m0 - m1) * (m0 - m1) * ((double)n0 * n1) / ((double)n * n);
     }
   const double n = (double)width_ * height_;
   e.meanLuminance = sumL / n;
@@ -90,6 +94,9 @@ std::vector<double> Film::Moments() const {
     double* o = &out[i * kMomentsPerPixel];
     for (int c = 0; c < 4; ++c) o[c] = n * mean_[4 * i + c];
     for (int c = 0; c < 3; ++c) o[4 + c] = m2_[3 * i + c] + n * (double)mean_[4 * i + c] * mean_[4 * i + c];
+    const double n0 = EvenSamples(samples_);
+    o[7] = n0;
+    o[8] = n0 * evenLuminance_[i];
   }
   return out;
 }
@@ -102,6 +109,7 @@ Film Film::FromMoments(int width, int height, uint32_t samples, const std::vecto
                                 std::to_string(width) + " x " + std::to_string(height) + " pixels");
   film.samples_ = samples;
   if (samples == 0) return film;
+  film.combinedEvenSamples_ = (uint32_t)std::llround(moments[7]);  // the same in every pixel of uniform films
   const double n = samples;
   for (size_t i = 0; i < pixels; ++i) {
     const double* m = &moments[i * kMomentsPerPixel];
@@ -109,6 +117,7 @@ Film Film::FromMoments(int width, int height, uint32_t samples, const std::vecto
     // M2 = sum over films of (M2 + n mean^2) - n mean^2 of the whole; never
     // below 0 (rounding where all samples agree).
     for (int c = 0; c < 3; ++c) film.m2_[3 * i + c] = (float)std::max(0.0, m[4 + c] - m[c] * m[c] / n);
+    film.evenLuminance_[i] = m[7] > 0 ? (float)(m[8] / m[7]) : 0.f;
   }
   return film;
 }

@@ -14,7 +14,7 @@ namespace mmrtm {
 struct NoiseEstimate {
   double meanLuminance = 0;     // over all pixels
   // Root mean square over pixels of the standard error of the luminance
-  // mean, bounded from above by the channels' standard errors (Film::Noise).
+  // mean, from the difference of the two replicates' means (Film::Noise).
   double rmsStandardError = 0;
   double relative = 0;          // rmsStandardError / meanLuminance
 };
@@ -32,7 +32,8 @@ class Film {
   Film(int width, int height);
 
   FilmView View() {
-    return FilmView{width_, height_, mean_.data(), m2_.data(), work_.empty() ? nullptr : work_.data()};
+    return FilmView{width_, height_, mean_.data(), m2_.data(), work_.empty() ? nullptr : work_.data(),
+                    evenLuminance_.data()};
   }
   void Reset();
   int Width() const { return width_; }
@@ -63,8 +64,16 @@ class Film {
 
   RGB Mean(int x, int y) const;
   float Alpha(int x, int y) const { return mean_[4 * ((size_t)y * width_ + x) + 3]; }
-  // Variance of the pixel's mean estimate, per channel (0 before 2 samples).
+  // Variance of the pixel's mean estimate, per channel, from the samples'
+  // spread (0 before 2 samples): exact in expectation for independent
+  // samples, above the error for stratified (Sobol') ones.
   RGB VarianceOfMean(int x, int y) const;
+  // The image's relative noise, from the pixels' two replicates (even and
+  // odd sample indices, independently scrambled): per pixel, the squared
+  // difference of their mean luminances, scaled to the variance of the
+  // whole mean, is an unbiased estimate of it with one degree of freedom,
+  // for independent and stratified samples alike; summed over the pixels
+  // it is a precise one. What noise targets stop on.
   NoiseEstimate Noise() const;
 
   RGBImage Linear() const;
@@ -76,21 +85,29 @@ class Film {
   // Sample-parallel rendering: films of independent sample streams of one
   // image (other seeds, other processes) combine into one film as if all
   // their samples had been added to it, by summing their moments. Per
-  // pixel, kMomentsPerPixel doubles: n mean (RGBA) and M2 + n mean^2 (RGB),
-  // with n the film's samples. Sums in double: exact enough for the
+  // pixel, kMomentsPerPixel doubles: n mean (RGBA), M2 + n mean^2 (RGB),
+  // and n0 and n0 times the even samples' mean luminance, with n the film's
+  // samples and n0 its even ones. Sums in double: exact enough for the
   // variance of thousands of samples. Uniform films only: an adaptive
   // film's moments would need its counts (std::logic_error).
-  static constexpr int kMomentsPerPixel = 7;
+  static constexpr int kMomentsPerPixel = 9;
   std::vector<double> Moments() const;
   // The film whose samples are `samples` in all, from the element-wise sum
   // of the Moments() of films of this size (samples = the sum of theirs).
+  // It is for reading: its replicates are the parts' (Noise), and samples
+  // rendered into it would not continue them (Reset it first).
   static Film FromMoments(int width, int height, uint32_t samples, const std::vector<double>& moments);
 
  private:
   int width_, height_;
   uint32_t samples_ = 0;
   std::vector<uint32_t> pixelSamples_;  // empty: every pixel has samples_
-  std::vector<float> mean_, m2_, work_;
+  std::vector<float> mean_, m2_, work_, evenLuminance_;
+  // A film combined by FromMoments: the even samples of every pixel (the
+  // parts' (n + 1) / 2 summed, more than half of the whole where parts had
+  // odd counts); 0 for a rendered film, whose n samples hold (n + 1) / 2.
+  uint32_t combinedEvenSamples_ = 0;
+  uint32_t EvenSamples(uint32_t n) const { return combinedEvenSamples_ ? combinedEvenSamples_ : (n + 1) / 2; }
 };
 
 }  // namespace mmrtm

@@ -1,7 +1,10 @@
 // Progressive film: per-pixel running mean and variance (Welford) of the
-// RGB radiance estimates and the mean alpha, in float. The variance lets the
-// renderer report its own noise: the standard error of a pixel's mean is
-// sqrt(M2 / (n (n - 1))).
+// RGB radiance estimates and the mean alpha, in float, and the running mean
+// luminance of the pixel's even samples (replicate 0 of mmrtm/sobol.h).
+// The variance is the samples' spread: the standard error of a pixel's mean
+// is sqrt(M2 / (n (n - 1))) for independent samples, an overstatement for
+// stratified ones. The even samples' mean against the odd ones' gives the
+// error of the mean for either kind (Film::Noise).
 #pragma once
 
 #include "mmrtm/defs.h"
@@ -14,8 +17,9 @@ struct FilmView {
   float* mean = nullptr;  // 4 floats a pixel: RGB radiance and alpha (coverage)
   float* m2 = nullptr;    // 3 floats a pixel: sum of squared deviations of RGB
   float* work = nullptr;  // optional, 1 float a pixel: TraceCounters::Work of its samples
+  float* evenLuminance = nullptr;  // 1 float a pixel: mean luminance of samples 0, 2, 4 ...
 
-  // Adds sample number n (1-based) of pixel (x, y).
+  // Adds sample number n (1-based, so sample index n - 1) of pixel (x, y).
   MMRTM_CPU_GPU void AddSample(int x, int y, RGB L, float alpha, uint32_t n) const {
     int64_t i = x + (int64_t)width * y;
     float* m = mean + 4 * i;
@@ -27,6 +31,10 @@ struct FilmView {
       s[c] += delta * (L[c] - m[c]);
     }
     m[3] += (alpha - m[3]) * inv;
+    if (n & 1u) {  // an even sample index: the (n + 1) / 2-th sample of replicate 0
+      float& e = evenLuminance[i];
+      e += (Luminance(L) - e) / (float)((n + 1) / 2);
+    }
   }
   MMRTM_CPU_GPU void AddWork(int x, int y, float units) const {
     if (work) work[x + (int64_t)width * y] += units;

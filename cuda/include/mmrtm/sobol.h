@@ -7,9 +7,10 @@
 // with its own hash (pbrt-v4's FastOwenScrambler, Laine and Karras 2011).
 // The shuffle is Burley's (2020): a nested uniform scramble of the index,
 // which flips each bit by a hash of the bits above it. So:
-//   - a pixel's first 2^k samples of a pair are a (0, k, 2)-net: stratified
-//     in every elementary interval, whatever k (the shuffle maps indices
-//     0 .. 2^k - 1 onto an aligned block of 2^k, which is a net as well);
+//   - a pixel's first 2^k even samples of a pair, and its first 2^k odd
+//     ones, are each a (0, k, 2)-net: stratified in every elementary
+//     interval, whatever k (the shuffle maps net indices 0 .. 2^k - 1 onto
+//     an aligned block of 2^k, which is a net as well);
 //   - the pairs of one sample are not correlated with each other: without
 //     the shuffle every pair would use the same index, and the pixel
 //     position's first bit would decide the free path's first bit (a plain
@@ -18,7 +19,14 @@
 //   - every sample point is uniform on its unit square (scrambling), so an
 //     estimator stays unbiased; pixels and seeds are decorrelated by hashes;
 //   - a number depends only on (seed, pixel, sample index, pair): the same
-//     on every thread count and backend (DESIGN.md rule 2).
+//     on every thread count and backend (DESIGN.md rule 2);
+//   - the sample index's lowest bit picks one of two replicates, which are
+//     independently scrambled nets (of index >> 1): the even samples of a
+//     pixel and its odd samples are two independent estimates of its value,
+//     and the difference of their means tells the error of the pixel's mean
+//     (Film::Noise), which the samples' spread overstates for stratified
+//     samples (Owen 1997: randomised QMC needs independent replicates for
+//     its variance).
 // A pair costs two hashes and a few dozen bit operations, without loops or
 // branches (a loop over the index bits with a data-dependent branch made
 // a sample 12-15 % slower on the CPU).
@@ -68,12 +76,16 @@ MMRTM_CPU_GPU inline uint32_t OwenScrambleReversed(uint32_t v, uint32_t seed) {
   return ReverseBits32(v);
 }
 
+// The replicate of a sample index (see above): 0 for even, 1 for odd.
+MMRTM_CPU_GPU inline uint32_t SobolReplicate(uint32_t sampleIndex) { return sampleIndex & 1u; }
+
 // The low-discrepancy pairs of one pixel sample, computed when asked for.
 class SobolPairs {
  public:
   MMRTM_CPU_GPU SobolPairs(uint64_t seed, uint64_t pixelIndex, uint32_t sampleIndex)
-      : key_(MixBits(pixelIndex ^ MixBits(seed + 0x5851f42d4c957f2dULL))),
-        reversedIndex_(ReverseBits32(sampleIndex)) {}
+      : key_(MixBits(pixelIndex ^ MixBits(seed + 0x5851f42d4c957f2dULL +
+                                          SobolReplicate(sampleIndex) * 0xda942042e4dd58b5ULL))),
+        reversedIndex_(ReverseBits32(sampleIndex >> 1)) {}
 
   // Pair `pair`, uniform on [0, 1)^2.
   MMRTM_CPU_GPU void Get(int pair, float* u0, float* u1) const {
