@@ -17,7 +17,7 @@ struct FilmView {
   float* mean = nullptr;  // 4 floats a pixel: RGB radiance and alpha (coverage)
   float* m2 = nullptr;    // 3 floats a pixel: sum of squared deviations of RGB
   float* work = nullptr;  // optional, 1 float a pixel: TraceCounters::Work of its samples
-  float* evenLuminance = nullptr;  // 1 float a pixel: mean luminance of samples 0, 2, 4 ...
+  float* evenLuminance = nullptr;  // required, 1 float a pixel: mean luminance of samples 0, 2, 4 ...
 
   // Adds sample number n (1-based, so sample index n - 1) of pixel (x, y).
   MMRTM_CPU_GPU void AddSample(int x, int y, RGB L, float alpha, uint32_t n) const {

@@ -25,8 +25,8 @@
 //     pixel and its odd samples are two independent estimates of its value,
 //     and the difference of their means tells the error of the pixel's mean
 //     (Film::Noise), which the samples' spread overstates for stratified
-//     samples (Owen 1997: randomised QMC needs independent replicates for
-//     its variance).
+//     samples (randomised quasi-Monte Carlo's usual error estimate:
+//     independent randomisations, compared).
 // A pair costs two hashes and a few dozen bit operations, without loops or
 // branches (a loop over the index bits with a data-dependent branch made
 // a sample 12-15 % slower on the CPU).
