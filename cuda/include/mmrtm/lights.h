@@ -46,17 +46,21 @@ struct EnvironmentView {
     DirectionToUV(w, &u, &v);
     return Texel(u, v);
   }
+  // Solid-angle pdf of sampling the direction of (u, v).
+  MMRTM_CPU_GPU float PdfAtUV(float u, float v) const {
+    return SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi));
+  }
   // Solid-angle pdf of sampling direction w.
   MMRTM_CPU_GPU float Pdf(Vec3 w) const {
     float u, v;
     DirectionToUV(w, &u, &v);
-    return SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi));
+    return PdfAtUV(u, v);
   }
   // Le(w) and Pdf(w) from one conversion of w to (u, v).
   MMRTM_CPU_GPU RGB LeAndPdf(Vec3 w, float* pdf) const {
     float u, v;
     DirectionToUV(w, &u, &v);
-    *pdf = SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi));
+    *pdf = PdfAtUV(u, v);
     return Texel(u, v);
   }
 };
