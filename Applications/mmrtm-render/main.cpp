@@ -60,7 +60,9 @@ options:
                         --noise-target, the most it renders
   --noise-target R      stop once the image's relative noise (its estimated RMS
                         standard error over its mean luminance) is at most R, e.g.
-                        0.01; checked after passes of 4, 8, 16 ... 64 spp
+                        0.01; checked after each pass: 4 spp first, then what
+                        the measured noise says is missing (a pass at most
+                        doubles the samples, and adds at most 64)
   --light-sampling L    next-event estimation with several lights: resampled (one
                         shadow ray, to a light chosen by its unshadowed contribution;
                         default), one (a light chosen uniformly) or all (a shadow ray
@@ -105,9 +107,7 @@ options:
 // GPU backend uploads.
 json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t inputVoxelBytes) {
   const mmrtm::SceneFootprint f = mmrtm::MeasureSceneView(view);
-  size_t summaries = 0;
-  if (const mmrtm::MajorantGrid* grid = scene.Grid())
-    for (int k = 0; k < grid->ProxyCount(); ++k) summaries += grid->Summaries(k).size() * sizeof(uint64_t);
+  const size_t summaries = scene.Grid() ? scene.Grid()->SummaryBytes() : 0;
   const auto& dims = scene.proxies.at(0).dims;
   const double voxels = (double)dims[0] * dims[1] * dims[2];
   const size_t held = f.voxels + f.tables + f.majorants + summaries;

@@ -9,7 +9,9 @@
 //     agree within their noise, also after a TF change and refit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "TestSceneHelpers.h"
 #include "cpu_renderer.h"
@@ -202,17 +204,90 @@ TEST(Refit, ByteTablesGiveTheSameLeafMajorantsAsTheBins) {
   const MajorantGrid& grid = *scene.Grid();
   const MajorantGrid::RefitTables tables = grid.MakeRefitTables(view.classifier);
   RefitInputs bins, bytes;
-  bins.summaries[0] = bytes.summaries[0] = grid.Summaries(0).data();
+  bins.summaries[0] = bytes.summaries[0] = grid.Summaries().Words(0);
   bins.binMax = bytes.binMax = tables.binMax.data();
   bins.binMaterials = bytes.binMaterials = tables.binMaterials.data();
   bytes.byteMax = tables.byteMax.data();
   int nonZero = 0;
-  for (int64_t leaf = 0; leaf < grid.LeafCount(); ++leaf) {
-    const float a = LeafMajorant(view.classifier, bins, leaf), b = LeafMajorant(view.classifier, bytes, leaf);
-    ASSERT_EQ(a, b) << "leaf " << leaf;
+  for (int64_t s = 0; s < (int64_t)grid.Summaries().Count(); ++s) {
+    const float a = SummaryMajorant(view.classifier, bins, s), b = SummaryMajorant(view.classifier, bytes, s);
+    ASSERT_EQ(a, b) << "summary " << s;
     nonZero += a > 0.f;
   }
   EXPECT_GT(nonZero, 100);
+}
+
+// Proxy k's summary words of a leaf.
+std::vector<uint64_t> LeafWords(const MajorantGrid& grid, int k, int64_t leaf) {
+  const uint64_t* w = grid.Summaries().Words(k) + (size_t)grid.LeafSummaryIds()[(size_t)leaf] * kSummaryWords;
+  return {w, w + kSummaryWords};
+}
+
+// Every stored summary is held by some leaf, and no two are equal.
+void ExpectDistinctAndHeld(const MajorantGrid& grid) {
+  const LeafSummaryTable& table = grid.Summaries();
+  std::vector<char> held(table.Count(), 0);
+  for (uint32_t id : grid.LeafSummaryIds()) {
+    ASSERT_LT(id, table.Count());
+    held[id] = 1;
+  }
+  EXPECT_EQ(std::count(held.begin(), held.end(), 1), (long)table.Count()) << "a summary no leaf holds";
+  std::set<std::vector<uint64_t>> distinct;
+  for (size_t s = 0; s < table.Count(); ++s) {
+    std::vector<uint64_t> tuple;
+    for (int k = 0; k < table.ProxyCount(); ++k)
+      tuple.insert(tuple.end(), table.Words(k) + s * kSummaryWords, table.Words(k) + (s + 1) * kSummaryWords);
+    distinct.insert(tuple);
+  }
+  EXPECT_EQ(distinct.size(), table.Count()) << "a summary stored twice";
+}
+
+TEST(LeafSummaries, TheTableGivesEqualTuplesOneIdAndCompactKeepsWhatIsHeld) {
+  LeafSummaryTable table;
+  table.Reset(2);
+  // Tuples of 2 proxies x 4 words; many more than the initial hash slots,
+  // so that the table rehashes on the way.
+  auto tuple = [](uint64_t i) {
+    std::vector<uint64_t> t(2 * kSummaryWords, 0);
+    t[i % 8] = 1ull << (i % 61);
+    t[(i / 8) % 8] |= 1ull << ((i / 8) % 59);
+    t[7] ^= i;
+    return t;
+  };
+  std::vector<uint32_t> ids;
+  for (uint64_t i = 0; i < 5000; ++i) ids.push_back(table.Insert(tuple(i).data()));
+  ASSERT_EQ(table.Count(), 5000u);
+  for (uint64_t i = 0; i < 5000; ++i) ASSERT_EQ(table.Insert(tuple(i).data()), ids[i]) << "tuple " << i;
+  ASSERT_EQ(table.Count(), 5000u) << "an equal tuple was stored again";
+  // Keep every third: Compact drops the rest and renumbers, words intact.
+  std::vector<uint32_t> held;
+  for (uint64_t i = 0; i < 5000; i += 3) held.push_back(ids[i]);
+  EXPECT_EQ(table.Compact(held), 5000u - held.size());
+  ASSERT_EQ(table.Count(), held.size());
+  for (size_t j = 0; j < held.size(); ++j) {
+    const std::vector<uint64_t> t = tuple(3 * j);
+    ASSERT_LT(held[j], table.Count());
+    for (int k = 0; k < 2; ++k)
+      for (int w = 0; w < kSummaryWords; ++w)
+        ASSERT_EQ(table.Words(k)[held[j] * kSummaryWords + w], t[k * kSummaryWords + w]) << "tuple " << 3 * j;
+    ASSERT_EQ(table.Insert(t.data()), held[j]) << "the hash index after Compact";
+  }
+  EXPECT_EQ(table.Insert(tuple(1).data()), held.size()) << "a dropped tuple is new again";
+}
+
+TEST(LeafSummaries, LeavesShareTheirSummaries) {
+  // The refit's cost and the summaries' memory follow the distinct
+  // summaries: on a real CT most leaves share theirs (measured: 10,904 of
+  // 365,148 leaves here).
+  Scene scene = SceneWith({LoadVolume(Data("ct_head_headsq.nrrd"))}, {CCTF({500.f, 1500.f}, {0.f, 1.f})}, 1.f,
+                          MajorantKind::Octree);
+  scene.Build();
+  const MajorantGrid& grid = *scene.Grid();
+  ASSERT_EQ((int64_t)grid.LeafSummaryIds().size(), grid.LeafCount());
+  EXPECT_LT(grid.Summaries().Count() * 10, (size_t)grid.LeafCount());
+  EXPECT_GT(grid.Summaries().Count(), 100u) << "leaves of a CT differ";
+  ExpectDistinctAndHeld(grid);
+  EXPECT_LT(grid.SummaryBytes(), (size_t)grid.LeafCount() * 8) << "4 B of id per leaf, and the table";
 }
 
 // Writes `value` into the voxels [lo, hi] of the scene's 64 x 64 x N int16
@@ -240,6 +315,11 @@ TEST(Refit, AfterADataChangeInARegionEqualsAFullRebuild) {
   rebuilt.Build();
   for (int64_t i = 0; i < rebuilt.Grid()->NodeCount(); ++i)
     ASSERT_EQ(updated.majorants.grid.majorants[i], rebuilt.Grid()->View().majorants[i]) << "node " << i;
+  // The same summary in every leaf, and the edited grid's table holds no
+  // summary that only the old data had.
+  for (int64_t leaf = 0; leaf < rebuilt.Grid()->LeafCount(); ++leaf)
+    ASSERT_EQ(LeafWords(*scene.Grid(), 0, leaf), LeafWords(*rebuilt.Grid(), 0, leaf)) << "leaf " << leaf;
+  ExpectDistinctAndHeld(*scene.Grid());
 }
 
 TEST(Refit, ARegionEditedBeyondTheValueRangeStillBoundsTheExtinction) {

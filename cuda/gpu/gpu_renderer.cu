@@ -44,9 +44,15 @@ __global__ void RenderSampleKernel(SceneView scene, FilmView film, uint32_t inde
   add(&counters->majorantViolations, ctr.majorantViolations);
 }
 
-__global__ void RefitLeavesKernel(Classifier c, RefitInputs in, float* majorants, int64_t leafOffset, int64_t leaves) {
+__global__ void RefitSummariesKernel(Classifier c, RefitInputs in, float* bounds, int64_t summaries) {
+  const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
+  if (s < summaries) bounds[s] = SummaryMajorant(c, in, s);
+}
+
+__global__ void RefitLeavesKernel(const float* bounds, const uint32_t* leafSummaryIds, float* majorants,
+                                  int64_t leafOffset, int64_t leaves) {
   const int64_t leaf = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (leaf < leaves) majorants[leafOffset + leaf] = LeafMajorant(c, in, leaf);
+  if (leaf < leaves) majorants[leafOffset + leaf] = bounds[leafSummaryIds[leaf]];
 }
 
 __global__ void RefitLevelKernel(MajorantGridView g, float* majorants, int level) {
@@ -69,7 +75,7 @@ struct GpuRenderer::Impl {
   std::vector<DeviceBuffer> tables;  // everything else, replaced on every SetScene
   float* majorants = nullptr;        // inside `tables`
   size_t majorantCount = 0;
-  DeviceBuffer summaries[kMaxProxies], binMax, binMaterials;
+  DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, binMax, binMaterials;
   DeviceBuffer filmMean, filmM2, filmEven, filmWork, counters, rangeFirst, rangeEnd;
   int filmWidth = 0, filmHeight = 0;
   uint32_t filmSamples = 0;
@@ -199,11 +205,20 @@ void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, 
     throw CudaError("GpuRenderer::Refit: the grid does not match the uploaded scene");
   RefitInputs in;
   const int64_t leaves = grid.LeafCount();
+  const std::vector<uint32_t>& ids = grid.LeafSummaryIds();
+  const LeafSummaryTable& table = grid.Summaries();
+  if (ids.size() != (size_t)leaves)
+    throw CudaError("GpuRenderer::Refit: the grid has no per-leaf summaries (voxel-value refit?)");
+  const bool upload = summariesChanged || m.leafSummaryIds.Bytes() != ids.size() * sizeof(uint32_t) ||
+                      m.summaryBounds.Bytes() != table.Count() * sizeof(float);
+  if (upload) {
+    m.leafSummaryIds.Allocate(ids.size() * sizeof(uint32_t), "majorant summaries");
+    m.leafSummaryIds.Upload(ids.data(), ids.size() * sizeof(uint32_t));
+    m.summaryBounds.Allocate(table.Count() * sizeof(float), "majorant summaries");
+  }
   for (int k = 0; k < grid.ProxyCount(); ++k) {
-    const std::vector<uint64_t>& s = grid.Summaries(k);
-    if (s.size() != (size_t)leaves * kSummaryWords)
-      throw CudaError("GpuRenderer::Refit: the grid has no per-leaf summaries (voxel-value refit?)");
-    if (summariesChanged || m.summaries[k].Bytes() != s.size() * sizeof(uint64_t)) {
+    const std::vector<uint64_t>& s = table.WordVector(k);
+    if (upload) {
       m.summaries[k].Allocate(s.size() * sizeof(uint64_t), "majorant summaries");
       m.summaries[k].Upload(s.data(), s.size() * sizeof(uint64_t));
     }
@@ -220,7 +235,14 @@ void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, 
 
   const MajorantGridView& g = m.device.majorants.grid;
   constexpr int kThreads = 256;
-  RefitLeavesKernel<<<Blocks(leaves, kThreads), kThreads>>>(m.device.classifier, in, m.majorants,
+  const int64_t summaries = (int64_t)table.Count();
+  if (summaries > 0) {
+    RefitSummariesKernel<<<Blocks(summaries, kThreads), kThreads>>>(m.device.classifier, in,
+                                                                   m.summaryBounds.As<float>(), summaries);
+    MMRTM_CUDA_CHECK(cudaGetLastError());
+  }
+  RefitLeavesKernel<<<Blocks(leaves, kThreads), kThreads>>>(m.summaryBounds.As<float>(),
+                                                            m.leafSummaryIds.As<uint32_t>(), m.majorants,
                                                             g.offset[g.leafLevel], leaves);
   MMRTM_CUDA_CHECK(cudaGetLastError());
   for (int level = g.leafLevel - 1; level >= 0; --level) {

@@ -169,16 +169,38 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
     if (options_.summary == SummaryMode::VoxelValues) continue;
     leafIndexToProxy_[k] = AffineCompose(v.View().worldToIndex, v0.indexToWorld);
     sameGrid_[k] = AffineIsIdentity(leafIndexToProxy_[k], 1e-5f) && v.dims == v0.dims;
-    summaries_[k].assign((size_t)LeafCount() * kSummaryWords, 0);
   }
+  summaries_.Reset(proxyCount_);
+  leafSummaryIds_.clear();
+  leafSummaryIds_.shrink_to_fit();
   // The voxel-value refit reads the voxels themselves: no summaries.
   if (options_.summary == SummaryMode::CellRanges) {
     const int L = view_.leafLevel;
     const int lo[3] = {0, 0, 0}, hi[3] = {view_.res[L][0] - 1, view_.res[L][1] - 1, view_.res[L][2] - 1};
-    ParallelFor(view_.res[L][2], options_.threads,
-                [&](int64_t z0, int64_t z1) { BuildLeaves(proxies, (int)z0, (int)z1, lo, hi); });
+    leafSummaryIds_.resize((size_t)LeafCount());
+    SummarizeRegion(proxies, lo, hi);
   }
   buildSeconds_ = SecondsSince(start);
+}
+
+void MajorantGrid::SummarizeRegion(const std::vector<HostVolume>& proxies, const int lo[3], const int hi[3]) {
+  // Every leaf of the box in full first (in parallel), then each takes the
+  // id of its summary (in order, so that ids do not depend on threads).
+  const int L = view_.leafLevel, n[3] = {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1};
+  const size_t stride = (size_t)proxyCount_ * kSummaryWords;
+  std::vector<uint64_t> tuples((size_t)n[0] * n[1] * n[2] * stride, 0ull);
+  ParallelFor(n[2], options_.threads, [&](int64_t z0, int64_t z1) {
+    BuildLeaves(proxies, lo[2] + (int)z0, lo[2] + (int)z1, lo, hi, tuples.data());
+  });
+  const uint64_t* tuple = tuples.data();
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x, tuple += stride)
+        leafSummaryIds_[(size_t)(x + (int64_t)view_.res[L][0] * (y + (int64_t)view_.res[L][1] * z))] =
+            summaries_.Insert(tuple);
+  // Summaries that no leaf holds any more (after an edit) go, and the
+  // table's storage shrinks to what it holds.
+  summaries_.Compact(leafSummaryIds_);
 }
 
 void MajorantGrid::UpdateRegion(const std::vector<HostVolume>& proxies, std::array<int, 3> lo, std::array<int, 3> hi) {
@@ -191,28 +213,21 @@ void MajorantGrid::UpdateRegion(const std::vector<HostVolume>& proxies, std::arr
     leafLo[a] = std::clamp((lo[a] - 1 - m) / size, 0, view_.res[L][a] - 1);
     leafHi[a] = std::clamp((hi[a] + m) / size, 0, view_.res[L][a] - 1);
   }
-  for (int k = 0; k < proxyCount_; ++k)
-    for (int z = leafLo[2]; z <= leafHi[2]; ++z)
-      for (int y = leafLo[1]; y <= leafHi[1]; ++y)
-        for (int x = leafLo[0]; x <= leafHi[0]; ++x) {
-          uint64_t* w = &summaries_[k][(size_t)(x + (int64_t)view_.res[L][0] * (y + (int64_t)view_.res[L][1] * z)) *
-                                       kSummaryWords];
-          std::fill(w, w + kSummaryWords, 0ull);
-        }
-  ParallelFor(leafHi[2] - leafLo[2] + 1, options_.threads, [&](int64_t z0, int64_t z1) {
-    BuildLeaves(proxies, leafLo[2] + (int)z0, leafLo[2] + (int)z1, leafLo, leafHi);
-  });
+  SummarizeRegion(proxies, leafLo, leafHi);
   buildSeconds_ = SecondsSince(start);
 }
 
 void MajorantGrid::BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3],
-                               const int hi[3]) {
+                               const int hi[3], uint64_t* tuples) {
+  const size_t stride = (size_t)proxyCount_ * kSummaryWords;
+  const int64_t nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1;
   for (int z = z0; z < z1; ++z)
     for (int y = lo[1]; y <= hi[1]; ++y)
-      for (int x = lo[0]; x <= hi[0]; ++x) SummarizeLeaf(proxies, x, y, z);
+      for (int x = lo[0]; x <= hi[0]; ++x)
+        SummarizeLeaf(proxies, x, y, z, tuples + stride * (size_t)((x - lo[0]) + nx * ((y - lo[1]) + ny * (z - lo[2]))));
 }
 
-void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz) {
+void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz, uint64_t* tuple) {
   thread_local std::vector<int16_t> scratch;
   const int L = view_.leafLevel, size = view_.nodeSize[L], m = options_.margin;
   const int leaf[3] = {lx, ly, lz};
@@ -222,7 +237,6 @@ void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx,
     boxLo[a] = (float)std::max(0, leaf[a] * size - m);
     boxHi[a] = (float)std::min(view_.cells[a], (leaf[a] + 1) * size + m);
   }
-  const int64_t leafIndex = lx + (int64_t)view_.res[L][0] * (ly + (int64_t)view_.res[L][1] * lz);
   for (int k = 0; k < proxyCount_; ++k) {
     const HostVolume& v = proxies[k];
     // The voxels whose values points of the box can see in proxy k: the
@@ -248,7 +262,7 @@ void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx,
       }
     }
     const bool edges = v.interpolation == Interpolation::Trilinear && options_.summary == SummaryMode::CellRanges;
-    uint64_t* words = &summaries_[k][(size_t)leafIndex * kSummaryWords];
+    uint64_t* words = tuple + k * kSummaryWords;
     const std::vector<int16_t>& table = binTables_[k];
     const int tableMin = binTableMin_[k];
     switch (v.type) {
@@ -347,15 +361,20 @@ void MajorantGrid::Refit(const Classifier& c) {
   }
   const RefitTables tables = MakeRefitTables(c);
   RefitInputs in;
-  for (int k = 0; k < proxyCount_; ++k) in.summaries[k] = summaries_[k].data();
+  for (int k = 0; k < proxyCount_; ++k) in.summaries[k] = summaries_.Words(k);
   in.binMax = tables.binMax.data();
   in.binMaterials = tables.binMaterials.data();
   in.materialMasks = tables.materialMasks;
   in.byteMax = tables.byteMax.data();
-  // Leaves (the same per-leaf function as the CUDA refit), then the levels above.
-  const int64_t leafOffset = view_.offset[view_.leafLevel];
+  // Each distinct summary (the same function as the CUDA refit), its leaves,
+  // then the levels above.
+  std::vector<float> bounds(summaries_.Count());
+  ParallelFor((int64_t)bounds.size(), options_.threads, [&](int64_t begin, int64_t end) {
+    for (int64_t s = begin; s < end; ++s) bounds[(size_t)s] = SummaryMajorant(c, in, s);
+  });
+  float* leafMajorants = majorants_.data() + view_.offset[view_.leafLevel];
   ParallelFor(LeafCount(), options_.threads, [&](int64_t begin, int64_t end) {
-    for (int64_t leaf = begin; leaf < end; ++leaf) majorants_[leafOffset + leaf] = LeafMajorant(c, in, leaf);
+    for (int64_t leaf = begin; leaf < end; ++leaf) leafMajorants[leaf] = bounds[leafSummaryIds_[(size_t)leaf]];
   });
   RefitUpperLevels();
   refitSeconds_ = SecondsSince(start);

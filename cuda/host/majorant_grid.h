@@ -22,11 +22,15 @@
 // change of nearest voxel. `margin` adds whole cells around each leaf instead,
 // if ever needed.
 //
+// Leaves share summaries: each distinct one is stored once (leaf_summary_table.h)
+// and a leaf holds its id.
+//
 // Refit: the maximum of every TF over every bin (once per TF), then each
-// leaf's majorant as the maximum over the materials that can occur in it of
-// base density times the product over its density TFs of their maximum over
-// the leaf's bins; then every parent as the maximum of its children. The cost
-// depends on the number of leaves and bins, not on the number of voxels.
+// distinct summary's bound as the maximum over the materials that can occur
+// in it of base density times the product over its density TFs of their
+// maximum over the summary's bins; each leaf takes its summary's bound, then
+// every parent the maximum of its children. The cost depends on the number
+// of distinct summaries, leaves and bins, not on the number of voxels.
 #pragma once
 
 #include <array>
@@ -34,6 +38,7 @@
 #include <vector>
 
 #include "host_volume.h"
+#include "leaf_summary_table.h"
 #include "mmrtm/classifier.h"
 #include "mmrtm/majorant_grid.h"
 #include "mmrtm/majorant_refit.h"
@@ -55,8 +60,9 @@ struct MajorantGridOptions {
 
 // The automatic leaf level: the finest whose leaf count stays within this
 // budget. Finer leaves give tighter majorants (fewer null collisions) but a
-// refit costs time per leaf; 2^19 leaves refit in about 15 ms on 2 CPU cores
-// (Documentation/performance.md). A 512^3 volume gets 8-cell leaves (the
+// refit costs time per leaf (a 512^3 volume's 2^18 leaves refit in about
+// 1 ms on 2 CPU cores, Documentation/performance.md) and finer leaves cost
+// more majorant segments per ray. A 512^3 volume gets 8-cell leaves (the
 // paper's level 6), a 256^3 one 4-cell leaves.
 constexpr int64_t kMaxAutoLeaves = int64_t(1) << 19;
 constexpr float kPositionTolerance = 1e-3f;  // voxels; see "Rounding" above
@@ -72,7 +78,7 @@ class MajorantGrid {
   void Refit(const Classifier& classifier);
 
   // The per-TF bin tables a refit reads (mmrtm/majorant_refit.h), for the
-  // classifier's TFs; the CUDA refit uploads them with Summaries().
+  // classifier's TFs; the CUDA refit uploads them with the summaries.
   struct RefitTables {
     std::vector<float> binMax;
     std::vector<uint64_t> binMaterials;
@@ -82,9 +88,12 @@ class MajorantGrid {
     std::vector<float> byteMax;
   };
   RefitTables MakeRefitTables(const Classifier& classifier) const;
-  // Proxy k's leaf summaries: kSummaryWords words per leaf (empty with
-  // SummaryMode::VoxelValues, whose refit reads the voxels instead).
-  const std::vector<uint64_t>& Summaries(int proxy) const { return summaries_[proxy]; }
+  // The distinct leaf summaries, and each leaf's id among them (both empty
+  // with SummaryMode::VoxelValues, whose refit reads the voxels instead).
+  const LeafSummaryTable& Summaries() const { return summaries_; }
+  const std::vector<uint32_t>& LeafSummaryIds() const { return leafSummaryIds_; }
+  // What the summaries hold in memory (host only: refits read them).
+  size_t SummaryBytes() const { return summaries_.Bytes() + leafSummaryIds_.capacity() * sizeof(uint32_t); }
   int ProxyCount() const { return proxyCount_; }
   const MajorantGridView& View() const { return view_; }
   int LeafLevel() const { return view_.leafLevel; }
@@ -104,8 +113,13 @@ class MajorantGrid {
   };
 
  private:
-  void BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3], const int hi[3]);
-  void SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz);
+  // Summarizes the leaves [lo, hi] with z in [z0, z1) into `tuples`: the
+  // proxies' words of each, in x-fastest order over the box [lo, hi].
+  void BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3], const int hi[3],
+                   uint64_t* tuples);
+  void SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz, uint64_t* tuple);
+  // Summarizes the leaves [lo, hi] (inclusive) and gives them their ids.
+  void SummarizeRegion(const std::vector<HostVolume>& proxies, const int lo[3], const int hi[3]);
   void RefitFromVoxelValues(const Classifier& classifier);
   void RefitUpperLevels();
 
@@ -119,7 +133,8 @@ class MajorantGrid {
   // that the summaries look bins up instead of dividing (empty for float).
   std::array<std::vector<int16_t>, kMaxProxies> binTables_;
   std::array<int, kMaxProxies> binTableMin_{};
-  std::array<std::vector<uint64_t>, kMaxProxies> summaries_;
+  LeafSummaryTable summaries_;
+  std::vector<uint32_t> leafSummaryIds_;  // per leaf
   std::vector<float> majorants_;
   double buildSeconds_ = 0, refitSeconds_ = 0;
 };

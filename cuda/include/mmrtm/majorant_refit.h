@@ -1,9 +1,12 @@
 // The majorant refit after a TF or material change (paper section 4), per
 // node, shared by the CPU refit (cuda/host/majorant_grid.cpp, threads over
-// leaves) and the CUDA refit (cuda/gpu, a thread per leaf, then per node of
-// each upper level). Both read the same inputs, so they agree exactly:
-//   - each leaf's TF-independent summary: for every proxy a 256-bin mask of
-//     the values the leaf can interpolate to (built once per data load);
+// summaries and leaves) and the CUDA refit (cuda/gpu, a thread per summary,
+// then per leaf, then per node of each upper level). Both read the same
+// inputs, so they agree exactly:
+//   - the TF-independent leaf summaries: for every proxy a 256-bin mask of
+//     the values a leaf can interpolate to (built once per data load), each
+//     distinct one stored once (cuda/host/leaf_summary_table.h); a refit
+//     bounds each distinct summary, then gives every leaf its summary's bound;
 //   - per TF and bin, the TF's maximum over the bin's value range
 //     (coefficient TFs) or the materials it can pick there (material TFs),
 //     computed on the host (TFs x 256 entries, microseconds).
@@ -34,12 +37,12 @@ MMRTM_CPU_GPU inline void ForEachBin(const uint64_t* words, Fn fn) {
 
 // What a refit reads besides the classifier.
 struct RefitInputs {
-  const uint64_t* summaries[kMaxProxies] = {};  // per proxy: kSummaryWords words per leaf
+  const uint64_t* summaries[kMaxProxies] = {};  // per proxy: kSummaryWords words per distinct summary
   const float* binMax = nullptr;                // [tf * kSummaryBins + bin]: coefficient TFs
   const uint64_t* binMaterials = nullptr;       // [tf * kSummaryBins + bin]: material TFs, a mask of materials
   bool materialMasks = true;                    // false with more than 64 materials: every material counts
   // Optional: [tf][byte of the summary][its value] the maximum of binMax
-  // over the byte's set bits, so that a leaf's maximum takes a lookup per
+  // over the byte's set bits, so that a summary's maximum takes a lookup per
   // non-zero byte instead of one per set bin. The same maximum either way.
   const float* byteMax = nullptr;
 };
@@ -60,16 +63,17 @@ MMRTM_CPU_GPU inline float MaxOverBins(const RefitInputs& in, int t, const uint6
   return mx;
 }
 
-// The extinction bound of leaf `leaf`: over the materials that can occur in
-// it (the default, and whatever a material TF can pick from the leaf's
-// bins), the product of each density TF's maximum over the leaf's bins;
-// their maximum, or their sum for an additive mixture.
-MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& in, int64_t leaf) {
+// The extinction bound of the leaves with summary `summary`: over the
+// materials that can occur in them (the default, and whatever a material TF
+// can pick from the summary's bins), the product of each density TF's
+// maximum over the summary's bins; their maximum, or their sum for an
+// additive mixture.
+MMRTM_CPU_GPU inline float SummaryMajorant(const Classifier& c, const RefitInputs& in, int64_t summary) {
   // (A mixture has every material everywhere.)
   uint64_t candidates = c.additive ? ~0ull : (c.defaultMaterial != kNoMaterial ? 1ull << c.defaultMaterial : 0);
   for (int s = 0; s < c.selectorCount && in.materialMasks && !c.additive; ++s) {
     const int t = c.selectors[s];
-    ForEachBin(in.summaries[c.tfs[t].proxy] + leaf * kSummaryWords,
+    ForEachBin(in.summaries[c.tfs[t].proxy] + summary * kSummaryWords,
                [&](int b) { candidates |= in.binMaterials[t * kSummaryBins + b]; });
   }
   float majorant = 0.f;
@@ -79,7 +83,7 @@ MMRTM_CPU_GPU inline float LeafMajorant(const Classifier& c, const RefitInputs& 
     float d = mat.base[0];
     for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
       const int t = c.bindings[mat.bindingBegin + b].tf;
-      d *= MaxOverBins(in, t, in.summaries[c.tfs[t].proxy] + leaf * kSummaryWords);
+      d *= MaxOverBins(in, t, in.summaries[c.tfs[t].proxy] + summary * kSummaryWords);
     }
     majorant = c.additive ? majorant + d : Max(majorant, d);  // a mixture's extinctions add up
   }
