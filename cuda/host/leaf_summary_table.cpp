@@ -65,8 +65,10 @@ size_t LeafSummaryTable::Compact(std::vector<uint32_t>& ids) {
   for (size_t id = 0; id < count_; ++id) {
     if (renumbered[id] == UINT32_MAX) continue;
     renumbered[id] = kept;
-    for (int k = 0; k < proxyCount_; ++k)
-      std::copy_n(words_[k].begin() + id * kSummaryWords, kSummaryWords, words_[k].begin() + (size_t)kept * kSummaryWords);
+    if (kept != id)  // moves down only: the source lies after the destination
+      for (int k = 0; k < proxyCount_; ++k)
+        std::copy_n(words_[k].begin() + id * kSummaryWords, kSummaryWords,
+                    words_[k].begin() + (size_t)kept * kSummaryWords);
     ++kept;
   }
   const size_t dropped = count_ - kept;
