@@ -14,7 +14,7 @@ void LeafSummaryTable::Reset(int proxyCount) {
 }
 
 uint64_t LeafSummaryTable::Hash(const uint64_t* tuple) const {
-  // A multiply-xorshift mix of every word (splitmix64's finaliser).
+  // Each word folded in, then mixed by splitmix64's finaliser.
   uint64_t h = 0x9e3779b97f4a7c15ull;
   for (int i = 0; i < proxyCount_ * kSummaryWords; ++i) {
     h ^= tuple[i] + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
