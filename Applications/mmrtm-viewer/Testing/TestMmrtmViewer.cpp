@@ -313,6 +313,10 @@ class TestMmrtmViewer : public QObject {
     Viewer v;
     QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
     QVERIFY(RefineTo(v.window, 8));
+    // The mapper counts 8 samples once its background pass is done; the view
+    // shows them at its next repaint, which then updates the status line. A
+    // fixed wait can end before that repaint on a loaded machine.
+    QTRY_VERIFY_WITH_TIMEOUT(v.window.statusLine()->text().contains("8 samples/pixel"), 30000);
     QTest::qWait(100);
     const QImage window = v.window.grab().toImage().convertToFormat(QImage::Format_RGB888);
     const QString temporary = QString(MMRTM_TEST_OUTPUT_DIR) + "/mmrtm-viewer-window.png";
