@@ -113,6 +113,8 @@ json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t 
   const size_t held = f.voxels + f.tables + f.majorants + summaries;
   return {{"input_voxel_bytes", inputVoxelBytes}, {"proxy_voxel_bytes", f.voxels}, {"tf_table_bytes", f.tables},
           {"majorant_bytes", f.majorants}, {"summary_bytes", summaries}, {"environment_bytes", f.environment},
+          {"grid_leaves", scene.Grid() ? scene.Grid()->LeafCount() : 0},
+          {"distinct_leaf_summaries", scene.Grid() ? scene.Grid()->Summaries().Count() : 0},
           {"voxels", voxels}, {"bytes_per_voxel", held / voxels},
           {"input_bytes_per_voxel", inputVoxelBytes / voxels}};
 }

@@ -8,7 +8,8 @@ and reads the "memory" block of mmrtm-render --stats-json: the proxies'
 voxels as kept (native types, only proxies some TF reads), the majorant grid
 (all levels), the grid's per-leaf value summaries (host only; refits read
 them) and the TF tables, against the input volumes as read. Prints a
-Markdown table and keeps the numbers in MMRTM_REFERENCE_DIR/memory.json.
+Markdown table, and one of the distinct leaf summaries against the leaves,
+and keeps the numbers in MMRTM_REFERENCE_DIR/memory.json.
 """
 
 import json
@@ -38,6 +39,12 @@ def main():
         print(f"| {name} | {m['voxels']:,.0f} | {m['input_voxel_bytes'] / mib:.1f} | {m['input_bytes_per_voxel']:.2f} | "
               f"{m['proxy_voxel_bytes'] / mib:.1f} | {m['majorant_bytes'] / mib:.2f} | {m['summary_bytes'] / mib:.1f} | "
               f"{m['bytes_per_voxel']:.2f} | {held / m['input_voxel_bytes']:.2f} |", flush=True)
+    # The summaries' memory follows the distinct leaf summaries (each stored
+    # once) and the leaves (an id each).
+    print("\n| dataset | distinct leaf summaries | leaves |")
+    print("|---|---|---|")
+    for name, m in rows.items():
+        print(f"| {name} | {m['distinct_leaf_summaries']:,} | {m['grid_leaves']:,} |")
     acc.REFERENCE_DIR.mkdir(parents=True, exist_ok=True)
     (acc.REFERENCE_DIR / "memory.json").write_text(json.dumps(rows, indent=1))
 

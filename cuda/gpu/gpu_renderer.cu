@@ -111,7 +111,9 @@ struct GpuRenderer::Impl {
     filmM2.Download(host.m2, pixels * 3 * sizeof(float));
     filmEven.Download(host.evenLuminance, pixels * sizeof(float));
     if (host.work) filmWork.Download(host.work, pixels * sizeof(float));
-  }  // Renders sample indices [from, to) of every pixel, or with per-pixel
+  }
+
+  // Renders sample indices [from, to) of every pixel, or with per-pixel
   // ranges [first, end) of the pixels whose range holds them; one launch
   // per index: short kernels (no display watchdog), progress. Returns the
   // pass's counters through `out` (when given).

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "mmrtm/rng.h"
+
 namespace mmrtm {
 
 void LeafSummaryTable::Reset(int proxyCount) {
@@ -14,14 +16,9 @@ void LeafSummaryTable::Reset(int proxyCount) {
 }
 
 uint64_t LeafSummaryTable::Hash(const uint64_t* tuple) const {
-  // Each word folded in, then mixed by splitmix64's finaliser.
+  // Each word folded into the running hash and mixed (the renderer's MixBits).
   uint64_t h = 0x9e3779b97f4a7c15ull;
-  for (int i = 0; i < proxyCount_ * kSummaryWords; ++i) {
-    h ^= tuple[i] + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-    h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
-    h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
-    h ^= h >> 31;
-  }
+  for (int i = 0; i < proxyCount_ * kSummaryWords; ++i) h = MixBits(h ^ tuple[i]) + 0x9e3779b97f4a7c15ull;
   return h;
 }
 
