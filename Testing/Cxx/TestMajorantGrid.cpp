@@ -85,7 +85,9 @@ Violations CheckAlongRandomRays(const SceneView& s, int rays, float scale, uint6
         // grid ends at the volume's faces. Points beyond them are outside.
         const Vec3 p = indexRay(t);
         if (skipped && (p.x < 0.f || p.y < 0.f || p.z < 0.f || p.x > hi.x || p.y > hi.y || p.z > hi.z)) continue;
-        const float sigma = scale * s.classifier.Classify(ray(t)).sigma_t;
+        // Where the tracker's lookups sample: proxies on proxy 0's grid at
+        // the index ray's point (Classifier::onProxy0Grid).
+        const float sigma = scale * s.classifier.Classify(ray(t), indexRay(t)).sigma_t;
         ++v.lookups;
         if (skipped && sigma > 0.f) ++v.inSkippedSpace;
         if (!skipped && sigma > majorant * (1.f + 1e-5f)) ++v.overMajorant;
@@ -153,6 +155,77 @@ TEST_P(Conservative, SingleLabelTimesCTOnTwoProxies) {
   for (int64_t i = 0; i < leaves; ++i) nonEmpty += g.majorants[g.offset[g.leafLevel] + i] > 0.f;
   EXPECT_GT(nonEmpty, 0);
   EXPECT_LT(nonEmpty, leaves / 20) << nonEmpty << " of " << leaves << " leaves";
+}
+
+TEST(LabelSummaries, OnSameVoxelGridToleratesTheRoundingOfFarOrigins) {
+  // The MRI's header: an origin of a few hundred mm. Through world-to-index
+  // and back, its map rounds by about 1e-5, which the earlier test (the
+  // composed map within 1e-5 of the identity) took for another grid.
+  HostVolume a;
+  a.dims = {4, 5, 6};
+  a.indexToWorld = IndexToWorld({-388.26, -81.12, 405.42}, {1.0, 0.898437, 0.898437}, {1, 0, 0, 0, 1, 0, 0, 0, 1});
+  HostVolume b = a;
+  b.indexToWorld = AffineInverse(a.View().worldToIndex);
+  EXPECT_TRUE(OnSameVoxelGrid(b, a));
+  EXPECT_TRUE(OnSameVoxelGrid(a, a));
+  HostVolume shifted = a;
+  shifted.indexToWorld.m[0][3] += 0.05f;  // a twentieth of a voxel
+  EXPECT_FALSE(OnSameVoxelGrid(shifted, a));
+  HostVolume finer = a;
+  finer.indexToWorld.m[1][1] *= 0.999f;
+  EXPECT_FALSE(OnSameVoxelGrid(finer, a));
+  HostVolume larger = a;
+  larger.dims = {4, 5, 7};
+  EXPECT_FALSE(OnSameVoxelGrid(larger, a));
+}
+
+TEST(LabelSummaries, ALabelMapOnTheImageGridIsSummarizedOverExactVoxelBoxes) {
+  // The CTA's label map shares the image's grid: the tracker samples it at
+  // the image's index coordinates, and a leaf's summary holds the labels of
+  // the voxels of its closed box [x s, (x + 1) s] and no others. So with a
+  // density of one label times a constant, the non-empty leaves are exactly
+  // those whose box holds that label (a one-voxel margin, which the grid
+  // took when the identity test failed on rounding, gave 486 leaves for 212).
+  HostVolume ct = LoadVolume(Data("cta_chest_aorta.nii.gz"));
+  HostVolume labels = LoadVolume(Data("cta_chest_aorta_labels.nii.gz"), "labels", Interpolation::Nearest);
+  ASSERT_TRUE(OnSameVoxelGrid(labels, ct));
+  TransferFunctionDesc label3;
+  label3.where = "test";
+  label3.type = TFType::CDPTF;
+  label3.proxy = 1;
+  label3.keys = {3.f};
+  label3.values = {1.f};
+  Scene scene = SceneWith({ct, labels}, {label3, CCTF({-5000.f, 5000.f}, {1.f, 1.f})}, 1.f, MajorantKind::Octree);
+  const SceneView s = scene.Build();
+  EXPECT_TRUE(s.classifier.onProxy0Grid[1]);
+  const MajorantGridView& g = scene.Grid()->View();
+  const int L = g.leafLevel, size = g.nodeSize[L];
+  std::set<int64_t> expected;
+  for (int z = 0; z < labels.dims[2]; ++z)
+    for (int y = 0; y < labels.dims[1]; ++y)
+      for (int x = 0; x < labels.dims[0]; ++x) {
+        if (labels.Value(x + (int64_t)labels.dims[0] * (y + (int64_t)labels.dims[1] * z)) != 3.f) continue;
+        // The leaves whose closed box holds voxel (x, y, z): one per axis,
+        // two where the voxel lies on a face between leaves.
+        const int p[3] = {x, y, z};
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          hi[a] = std::min(p[a] / size, g.res[L][a] - 1);
+          lo[a] = p[a] % size == 0 && p[a] > 0 ? p[a] / size - 1 : hi[a];
+        }
+        for (int lz = lo[2]; lz <= hi[2]; ++lz)
+          for (int ly = lo[1]; ly <= hi[1]; ++ly)
+            for (int lx = lo[0]; lx <= hi[0]; ++lx) expected.insert(g.Index(L, lx, ly, lz));
+      }
+  ASSERT_GT(expected.size(), 10u);
+  int64_t nonEmpty = 0, unexpected = 0;
+  for (int64_t i = g.offset[L]; i < g.offset[L] + scene.Grid()->LeafCount(); ++i) {
+    if (!(g.majorants[i] > 0.f)) continue;
+    ++nonEmpty;
+    unexpected += !expected.count(i);
+  }
+  EXPECT_EQ(unexpected, 0);
+  EXPECT_EQ(nonEmpty, (int64_t)expected.size());
 }
 
 INSTANTIATE_TEST_SUITE_P(Accelerators, Conservative,

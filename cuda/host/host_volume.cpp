@@ -1,10 +1,26 @@
 #include "host_volume.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
 namespace mmrtm {
+
+bool OnSameVoxelGrid(const HostVolume& v, const HostVolume& grid) {
+  if (v.dims != grid.dims) return false;
+  // Entry by entry, relative to the largest (origins of a few hundred mm
+  // carry rounding of about 1e-5 mm; a composed world-to-index-to-world map
+  // would carry it into index units, and miss grids that are the same).
+  float scale = 1.f;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c)
+      scale = std::max({scale, std::fabs(v.indexToWorld.m[r][c]), std::fabs(grid.indexToWorld.m[r][c])});
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (std::fabs(v.indexToWorld.m[r][c] - grid.indexToWorld.m[r][c]) > 1e-6f * scale) return false;
+  return true;
+}
 
 VolumeView HostVolume::View() const {
   VolumeView v;

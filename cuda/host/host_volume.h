@@ -42,6 +42,13 @@ struct HostVolume {
   void Validate() const;
 };
 
+// Whether `v` lies on the voxel grid of `grid`: the same dimensions and the
+// same index-to-world map to within float rounding (a label map or a derived
+// proxy resampled to the image). The tracker then samples `v` at `grid`'s
+// index coordinates, and the majorant grid summarizes it over exact voxel
+// boxes (Classifier::onProxy0Grid, MajorantGrid).
+bool OnSameVoxelGrid(const HostVolume& v, const HostVolume& grid);
+
 // index -> world from origin, spacing and a 3x3 direction matrix (columns are
 // the directions of the i, j, k axes), as in ITK and NRRD.
 Affine3 IndexToWorld(const std::array<double, 3>& origin, const std::array<double, 3>& spacing,

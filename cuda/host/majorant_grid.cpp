@@ -168,7 +168,7 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
     }
     if (options_.summary == SummaryMode::VoxelValues) continue;
     leafIndexToProxy_[k] = AffineCompose(v.View().worldToIndex, v0.indexToWorld);
-    sameGrid_[k] = AffineIsIdentity(leafIndexToProxy_[k], 1e-5f) && v.dims == v0.dims;
+    sameGrid_[k] = OnSameVoxelGrid(v, v0);
   }
   summaries_.Reset(proxyCount_);
   leafSummaryIds_.clear();

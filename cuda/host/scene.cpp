@@ -279,7 +279,10 @@ SceneView Scene::Build() {
   SceneView s;
   Classifier& c = s.classifier;
   c.proxyCount = (int)proxies.size();
-  for (int i = 0; i < c.proxyCount; ++i) c.proxies[i] = proxies[i].View();
+  for (int i = 0; i < c.proxyCount; ++i) {
+    c.proxies[i] = proxies[i].View();
+    c.onProxy0Grid[i] = i == 0 || OnSameVoxelGrid(proxies[i], proxies[0]);
+  }
   c.tfs = tfViews_.data();
   c.materials = materialViews_.data();
   c.bindings = bindings_.data();

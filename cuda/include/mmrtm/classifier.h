@@ -71,9 +71,21 @@ struct Classifier {
   // majorants are clamped alike, so they stay bounds.
   float maxExtinction = kInfinity;
 
+  // Proxies on proxy 0's voxel grid (OnSameVoxelGrid: a label map or a
+  // derived proxy resampled to the image; proxy 0 itself) are sampled at
+  // proxy 0's index coordinates, which the tracker has from its index-space
+  // ray: no transform per lookup, and the very coordinates over which the
+  // majorant grid summarizes them (exact voxel boxes, MajorantGrid).
+  bool onProxy0Grid[kMaxProxies] = {true};
+
   MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world) const {
+    return SampleProxies(world, proxies[0].worldToIndex.ApplyPoint(world));
+  }
+  // `index0`: `world` in proxy 0's index space.
+  MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world, Vec3 index0) const {
     ProxySamples s;
-    for (int i = 0; i < proxyCount; ++i) s.v[i] = proxies[i].SampleWorld(world);
+    for (int i = 0; i < proxyCount; ++i)
+      s.v[i] = onProxy0Grid[i] ? proxies[i].SampleIndex(index0) : proxies[i].SampleWorld(world);
     return s;
   }
 
@@ -91,6 +103,12 @@ struct Classifier {
   }
 
   MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
+    return Classify(world, proxies[0].worldToIndex.ApplyPoint(world));
+  }
+
+  // The same at a point given also in proxy 0's index space (`index0`; the
+  // tracker computes it from its index-space ray).
+  MMRTM_CPU_GPU Classification Classify(Vec3 world, Vec3 index0) const {
     Classification c;
 #ifdef MMRTM_PLAIN_SCENE_ONLY
     // Compiled only into the benchmark that measures what the general path
@@ -100,14 +118,14 @@ struct Classifier {
     const bool shortest = plain;
 #endif
     if (shortest) {
-      c.proxies.v[0] = proxies[0].SampleWorld(world);
+      c.proxies.v[0] = proxies[0].SampleIndex(index0);
       float v;
       tfs[bindings[materials[0].bindingBegin].tf].Evaluate(c.proxies.v[0], &v);
       c.sigma_t = Min(materials[0].base[0] * v, maxExtinction);
       c.material = 0;
       return c;
     }
-    c.proxies = SampleProxies(world);
+    c.proxies = SampleProxies(world, index0);
     if (additive) {
       for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
       c.material = c.sigma_t > 0.f ? 0 : kNoMaterial;  // a mixture: see Coefficients

@@ -74,7 +74,7 @@ class GridMajorantIterator {
     Vec3 p = r(tMin);
     for (int a = 0; a < 3; ++a) {
       float x = p[a] / (float)grid->nodeSize[level_];
-      cell_[a] = ClampInt((int)floorf(x), 0, grid->res[level_][a] - 1);
+      cell_[a] = FloorClamped(x, grid->res[level_][a] - 1);
     }
   }
 

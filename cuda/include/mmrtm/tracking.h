@@ -26,11 +26,12 @@ struct FreePathResult {
   Classification c;
 };
 
-// Classifies p, counting the lookup, and a violation if the (scaled)
-// extinction there exceeds the majorant that the tracker was given.
-MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, float sigma_maj, float scale,
-                                                    TraceCounters& ctr) {
-  Classification c = s.classifier.Classify(p);
+// Classifies p (`index0`: p in proxy 0's index space), counting the lookup,
+// and a violation if the (scaled) extinction there exceeds the majorant that
+// the tracker was given.
+MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, Vec3 index0, float sigma_maj,
+                                                    float scale, TraceCounters& ctr) {
+  Classification c = s.classifier.Classify(p, index0);
   ++ctr.densityLookups;
   if (scale * c.sigma_t > sigma_maj * 1.0001f) ++ctr.majorantViolations;
   return c;
@@ -69,7 +70,9 @@ MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ra
         break;
       }
       t += tau / seg.sigma_maj;  // below tMax but for rounding, which lands on this node's face
-      Classification c = LookupAndCount(s, ray(t), seg.sigma_maj, scale, ctr);
+      // The point also in proxy 0's index space, from the index ray: the
+      // proxies on proxy 0's grid are sampled there (Classifier::onProxy0Grid).
+      Classification c = LookupAndCount(s, ray(t), indexRay(t), seg.sigma_maj, scale, ctr);
       if (!visit(t, c, seg.sigma_maj)) return;
       tau = -logf(1.f - rng.Uniform());
     }
@@ -132,7 +135,7 @@ MMRTM_CPU_GPU inline FreePathResult RayMarch(const SceneView& s, const Ray& ray,
   float target = -logf(1.f - rng.Uniform());
   float depth = 0.f;
   for (float t = t0 + step * rng.Uniform(); t < t1; t += step) {
-    Classification c = LookupAndCount(s, ray(t), kInfinity, 1.f, ctr);
+    Classification c = LookupAndCount(s, ray(t), indexRay(t), kInfinity, 1.f, ctr);
     depth += c.sigma_t * step;
     if (depth >= target) {
       ++ctr.realCollisions;
@@ -154,7 +157,7 @@ MMRTM_CPU_GPU inline float RayMarchTransmittance(const SceneView& s, const Ray& 
   float step = s.settings.rayMarchStep;
   float depth = 0.f;
   for (float t = t0 + step * rng.Uniform(); t < t1; t += step)
-    depth += LookupAndCount(s, ray(t), kInfinity, 1.f, ctr).sigma_t * step;
+    depth += LookupAndCount(s, ray(t), indexRay(t), kInfinity, 1.f, ctr).sigma_t * step;
   return expf(-scale * depth);
 }
 

@@ -27,6 +27,10 @@ struct VolumeView {
   int nx = 0, ny = 0, nz = 0;
   Affine3 worldToIndex;  // world point -> continuous voxel index
 
+  // The voxel nearest to index coordinate x on an axis of n voxels, clamped
+  // to the axis (and 0 for NaN).
+  MMRTM_CPU_GPU static int NearestIndex(float x, int n) { return FloorClamped(x + 0.5f, n - 1); }
+
   MMRTM_CPU_GPU int64_t Offset(int x, int y, int z) const {
     MMRTM_DCHECK(x >= 0 && x < nx && y >= 0 && y < ny && z >= 0 && z < nz);
     return x + (int64_t)nx * (y + (int64_t)ny * z);
@@ -45,8 +49,7 @@ struct VolumeView {
   // Value at a continuous index position, clamped to the domain.
   MMRTM_CPU_GPU float SampleIndex(Vec3 p) const {
     if (interpolation == Interpolation::Nearest)
-      return Voxel(ClampInt((int)floorf(p.x + 0.5f), 0, nx - 1), ClampInt((int)floorf(p.y + 0.5f), 0, ny - 1),
-                   ClampInt((int)floorf(p.z + 0.5f), 0, nz - 1));
+      return Voxel(NearestIndex(p.x, nx), NearestIndex(p.y, ny), NearestIndex(p.z, nz));
     switch (type) {
       case VoxelType::UInt8: return Trilinear(static_cast<const uint8_t*>(data), p);
       case VoxelType::Int16: return Trilinear(static_cast<const int16_t*>(data), p);
