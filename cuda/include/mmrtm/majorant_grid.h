@@ -69,19 +69,26 @@ class GridMajorantIterator {
     // at the root cost every ray a descent through all levels.
     level_ = grid->leafLevel;
     // A multiply per face crossing instead of a division (0 where the ray
-    // is parallel to an axis, which ExitDistance skips).
-    for (int a = 0; a < 3; ++a) invD_[a] = d_[a] != 0.f ? 1.f / d_[a] : 0.f;
+    // is parallel to an axis, which ExitDistance skips), and the time at
+    // which the ray leaves the grid's last cell ahead (the last node of an
+    // axis is clipped to the volume).
+    for (int a = 0; a < 3; ++a) {
+      invD_[a] = d_[a] != 0.f ? 1.f / d_[a] : 0.f;
+      step_[a] = d_[a] > 0.f ? 1 : (d_[a] < 0.f ? -1 : 0);
+      tClip_[a] = d_[a] > 0.f ? ((float)grid->cells[a] - o_[a]) * invD_[a] : kInfinity;
+    }
     Vec3 p = r(tMin);
     for (int a = 0; a < 3; ++a) {
       float x = p[a] / (float)grid->nodeSize[level_];
       cell_[a] = FloorClamped(x, grid->res[level_][a] - 1);
     }
+    EnterLevel();
   }
 
   // The next segment with a non-zero majorant; false at the end of the ray.
   MMRTM_CPU_GPU bool Next(float* tMin, float* tMax, float* sigma_maj) {
     while (t_ < tEnd_) {
-      const float maj = grid_->Majorant(level_, cell_);
+      const float maj = grid_->majorants[node_];
       if (maj <= 0.f) {
         if (traversal_ == GridTraversal::Octree) ClimbToHighestEmptyAncestor();
         int axis;
@@ -116,17 +123,49 @@ class GridMajorantIterator {
   }
 
  private:
+  // After a change of level: the node's width, its index, the index steps
+  // to its neighbours and the crossing times of its faces ahead (kept so
+  // that a step along an axis is an add and one crossing time).
+  MMRTM_CPU_GPU void EnterLevel() {
+    size_ = (float)grid_->nodeSize[level_];
+    stride_[0] = 1;
+    stride_[1] = grid_->res[level_][0];
+    stride_[2] = (int64_t)grid_->res[level_][0] * grid_->res[level_][1];
+    node_ = grid_->Index(level_, cell_[0], cell_[1], cell_[2]);
+    for (int a = 0; a < 3; ++a) FaceAhead(a);
+  }
+
+  // The crossing time of the current node's face ahead on axis a, or of the
+  // volume's end where it clips the node: the earlier of the two crossing
+  // times is the crossing of the nearer plane (x -> (x - o) / d keeps the
+  // order). kInfinity where the ray is parallel to the axis.
+  MMRTM_CPU_GPU void FaceAhead(int a) {
+    if (step_[a] == 0) {
+      tFace_[a] = kInfinity;
+      return;
+    }
+    const float plane = (float)(cell_[a] + (step_[a] > 0 ? 1 : 0)) * size_;
+    tFace_[a] = Min((plane - o_[a]) * invD_[a], tClip_[a]);
+  }
+
   MMRTM_CPU_GPU void Climb() {
     --level_;
     for (int a = 0; a < 3; ++a) cell_[a] >>= 1;
+    EnterLevel();
   }
 
   MMRTM_CPU_GPU void ClimbToHighestEmptyAncestor() {
-    while (level_ > 0) {
-      int parent[3] = {cell_[0] >> 1, cell_[1] >> 1, cell_[2] >> 1};
-      if (grid_->Majorant(level_ - 1, parent) > 0.f) break;
-      Climb();
+    int top = level_;
+    while (top > 0) {
+      const int shift = level_ - top + 1;
+      const int parent[3] = {cell_[0] >> shift, cell_[1] >> shift, cell_[2] >> shift};
+      if (grid_->Majorant(top - 1, parent) > 0.f) break;
+      --top;
     }
+    if (top == level_) return;
+    for (int a = 0; a < 3; ++a) cell_[a] >>= level_ - top;
+    level_ = top;
+    EnterLevel();
   }
 
   // Into the child that the ray is in at t (ties go to the side it heads to).
@@ -141,18 +180,16 @@ class GridMajorantIterator {
       cell_[a] = ClampInt(2 * cell_[a] + (upper ? 1 : 0), 0, grid_->res[child][a] - 1);
     }
     level_ = child;
+    EnterLevel();
   }
 
   // Where the ray leaves the current node, and through which face (-1 when
   // the ray ends inside it).
   MMRTM_CPU_GPU float ExitDistance(int* axisOut) const {
-    const float size = (float)grid_->nodeSize[level_];
     float tExit = tEnd_;
     int axis = -1;
     for (int a = 0; a < 3; ++a) {
-      if (d_[a] == 0.f) continue;
-      float plane = d_[a] > 0.f ? Min((float)(cell_[a] + 1) * size, (float)grid_->cells[a]) : (float)cell_[a] * size;
-      float t = (plane - o_[a]) * invD_[a];
+      const float t = tFace_[a];
       if (t < tExit) {
         tExit = t;
         axis = a;
@@ -170,11 +207,13 @@ class GridMajorantIterator {
       t_ = tEnd_;
       return false;
     }
-    cell_[axis] += d_[axis] > 0.f ? 1 : -1;
+    cell_[axis] += step_[axis];
     if (cell_[axis] < 0 || cell_[axis] >= grid_->res[level_][axis]) {
       t_ = tEnd_;
       return false;
     }
+    node_ += step_[axis] * stride_[axis];
+    FaceAhead(axis);
     return true;
   }
 
@@ -184,6 +223,12 @@ class GridMajorantIterator {
   float t_ = 0.f, tEnd_ = 0.f, scale_ = 1.f;
   int level_ = 0;
   int cell_[3] = {0, 0, 0};
+  int step_[3] = {0, 0, 0};          // +1, -1 or 0: the ray's direction per axis
+  float tClip_[3] = {0.f, 0.f, 0.f};  // where it leaves the grid's last cell ahead (kInfinity: d <= 0)
+  float size_ = 1.f;                  // node width of level_, in voxel cells
+  int64_t node_ = 0;                  // the index of (level_, cell_)
+  int64_t stride_[3] = {1, 1, 1};     // index steps to the neighbours on level_
+  float tFace_[3] = {0.f, 0.f, 0.f};  // FaceAhead
   GridTraversal traversal_ = GridTraversal::Octree;
 };
 
