@@ -37,6 +37,7 @@ constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
 MMRTM_CPU_GPU inline float Clamp(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 MMRTM_CPU_GPU inline int ClampInt(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+MMRTM_CPU_GPU inline int MinInt(int a, int b) { return a < b ? a : b; }
 // floor(v) clamped to [0, hi] (hi >= 0), and 0 for NaN. The conversion
 // truncates only values in [1, hi), where truncation is the floor: one
 // instruction where floorf is about ten without SSE4.1, and no value beyond

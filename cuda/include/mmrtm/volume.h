@@ -73,10 +73,13 @@ struct VolumeView {
  private:
   template <typename T>
   MMRTM_CPU_GPU float Trilinear(const T* v, Vec3 p) const {
-    float fx = Clamp(p.x, 0.f, (float)(nx - 1)), fy = Clamp(p.y, 0.f, (float)(ny - 1)),
-          fz = Clamp(p.z, 0.f, (float)(nz - 1));
-    int x0 = ClampInt((int)fx, 0, nx > 1 ? nx - 2 : 0), y0 = ClampInt((int)fy, 0, ny > 1 ? ny - 2 : 0),
-        z0 = ClampInt((int)fz, 0, nz > 1 ? nz - 2 : 0);
+    // Clamped to the domain as Min(Max()), which compiles to two
+    // instructions (and takes NaN to 0); then the cell's first corner, which
+    // is at least 0 and at most n - 2 (0 on a flat axis of one voxel).
+    const float fx = Min(Max(p.x, 0.f), (float)(nx - 1)), fy = Min(Max(p.y, 0.f), (float)(ny - 1)),
+                fz = Min(Max(p.z, 0.f), (float)(nz - 1));
+    const int x0 = MinInt((int)fx, nx > 1 ? nx - 2 : 0), y0 = MinInt((int)fy, ny > 1 ? ny - 2 : 0),
+              z0 = MinInt((int)fz, nz > 1 ? nz - 2 : 0);
     int dx = nx > 1 ? 1 : 0, dy = ny > 1 ? nx : 0;
     int64_t dz = nz > 1 ? (int64_t)nx * ny : 0;
     float tx = fx - x0, ty = fy - y0, tz = fz - z0;
