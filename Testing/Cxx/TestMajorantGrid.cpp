@@ -34,6 +34,17 @@ TransferFunctionDesc CCTF(std::vector<float> keys, std::vector<float> values, in
   return tf;
 }
 
+// A single label's TF: `value` at label `label` of proxy `proxy`, 0 elsewhere.
+TransferFunctionDesc SingleLabel(float label, float value, int proxy) {
+  TransferFunctionDesc tf;
+  tf.where = "test";
+  tf.type = TFType::CDPTF;
+  tf.proxy = proxy;
+  tf.keys = {label};
+  tf.values = {value};
+  return tf;
+}
+
 // One material whose density is `density` times the given TFs.
 Scene SceneWith(std::vector<HostVolume> proxies, std::vector<TransferFunctionDesc> densityTFs, float density,
                 MajorantKind kind, SummaryMode summary = SummaryMode::CellRanges) {
@@ -135,13 +146,7 @@ TEST_P(Conservative, SingleLabelTimesCTOnTwoProxies) {
   // come on their own file, aligned in world space.
   HostVolume ct = LoadVolume(Data("cta_chest_aorta.nii.gz"));
   HostVolume labels = LoadVolume(Data("cta_chest_aorta_labels.nii.gz"), "labels", Interpolation::Nearest);
-  TransferFunctionDesc label3;
-  label3.where = "test";
-  label3.type = TFType::CDPTF;
-  label3.proxy = 1;
-  label3.keys = {3.f};
-  label3.values = {1.f};
-  Scene scene = SceneWith({ct, labels}, {label3, CCTF({100.f, 400.f}, {0.f, 1.f})}, 5.f, GetParam());
+  Scene scene = SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({100.f, 400.f}, {0.f, 1.f})}, 5.f, GetParam());
   SceneView s = scene.Build();
   Violations v = CheckAlongRandomRays(s, 1500, 1.f, 11);
   EXPECT_EQ(v.overMajorant, 0) << "of " << v.lookups << " lookups";
@@ -189,13 +194,8 @@ TEST(LabelSummaries, ALabelMapOnTheImageGridIsSummarizedOverExactVoxelBoxes) {
   HostVolume ct = LoadVolume(Data("cta_chest_aorta.nii.gz"));
   HostVolume labels = LoadVolume(Data("cta_chest_aorta_labels.nii.gz"), "labels", Interpolation::Nearest);
   ASSERT_TRUE(OnSameVoxelGrid(labels, ct));
-  TransferFunctionDesc label3;
-  label3.where = "test";
-  label3.type = TFType::CDPTF;
-  label3.proxy = 1;
-  label3.keys = {3.f};
-  label3.values = {1.f};
-  Scene scene = SceneWith({ct, labels}, {label3, CCTF({-5000.f, 5000.f}, {1.f, 1.f})}, 1.f, MajorantKind::Octree);
+  Scene scene =
+      SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({-5000.f, 5000.f}, {1.f, 1.f})}, 1.f, MajorantKind::Octree);
   const SceneView s = scene.Build();
   EXPECT_TRUE(s.classifier.onProxy0Grid[1]);
   const MajorantGridView& g = scene.Grid()->View();

@@ -69,9 +69,9 @@ class GridMajorantIterator {
     // at the root cost every ray a descent through all levels.
     level_ = grid->leafLevel;
     // A multiply per face crossing instead of a division (0 where the ray
-    // is parallel to an axis, which ExitDistance skips), and the time at
-    // which the ray leaves the grid's last cell ahead (the last node of an
-    // axis is clipped to the volume).
+    // is parallel to an axis, whose faces FaceAhead never crosses), and the
+    // time at which the ray leaves the grid's last cell ahead (the last node
+    // of an axis is clipped to the volume).
     for (int a = 0; a < 3; ++a) {
       invD_[a] = d_[a] != 0.f ? 1.f / d_[a] : 0.f;
       step_[a] = d_[a] > 0.f ? 1 : (d_[a] < 0.f ? -1 : 0);
