@@ -27,9 +27,7 @@ VolumeView HostVolume::View() const {
   v.data = voxels.data();
   v.type = type;
   v.interpolation = interpolation;
-  v.nx = dims[0];
-  v.ny = dims[1];
-  v.nz = dims[2];
+  v.SetExtent(dims[0], dims[1], dims[2]);
   try {
     v.worldToIndex = AffineInverse(indexToWorld);
   } catch (const std::runtime_error& e) {
