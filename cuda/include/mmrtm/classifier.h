@@ -84,9 +84,13 @@ struct Classifier {
   // `index0`: `world` in proxy 0's index space.
   MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world, Vec3 index0) const {
     ProxySamples s;
-    for (int i = 0; i < proxyCount; ++i)
-      s.v[i] = onProxy0Grid[i] ? proxies[i].SampleIndex(index0) : proxies[i].SampleWorld(world);
+    SampleProxies(world, index0, &s);
     return s;
+  }
+  // The same into `s` (Classify's own: no temporary to copy per lookup).
+  MMRTM_CPU_GPU void SampleProxies(Vec3 world, Vec3 index0, ProxySamples* s) const {
+    for (int i = 0; i < proxyCount; ++i)
+      s->v[i] = onProxy0Grid[i] ? proxies[i].SampleIndex(index0) : proxies[i].SampleWorld(world);
   }
 
   // Extinction of material m at the sampled proxy values.
@@ -125,7 +129,7 @@ struct Classifier {
       c.material = 0;
       return c;
     }
-    c.proxies = SampleProxies(world, index0);
+    SampleProxies(world, index0, &c.proxies);
     if (additive) {
       for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
       c.material = c.sigma_t > 0.f ? 0 : kNoMaterial;  // a mixture: see Coefficients
