@@ -16,6 +16,17 @@
 #define MMRTM_CPU_GPU
 #endif
 
+// For the few per-sample functions that the host compiler leaves out of line
+// although they are called at every density lookup (its call and spills cost
+// more than their body saves in code size).
+#if defined(__CUDACC__)
+#define MMRTM_INLINE __forceinline__
+#elif defined(__GNUC__)
+#define MMRTM_INLINE inline __attribute__((always_inline))
+#else
+#define MMRTM_INLINE inline
+#endif
+
 // Debug-only check; compiled out on the device and in release builds.
 #if !defined(NDEBUG) && !defined(__CUDA_ARCH__)
 #include <cassert>

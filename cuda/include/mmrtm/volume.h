@@ -70,7 +70,7 @@ struct VolumeView {
   }
 
   // Value at a continuous index position, clamped to the domain.
-  MMRTM_CPU_GPU float SampleIndex(Vec3 p) const {
+  MMRTM_INLINE MMRTM_CPU_GPU float SampleIndex(Vec3 p) const {
     if (interpolation == Interpolation::Nearest)
       return Voxel(NearestIndex(p.x, nx), NearestIndex(p.y, ny), NearestIndex(p.z, nz));
     switch (type) {
