@@ -16,8 +16,8 @@ using namespace mmrtm::test;
 
 namespace {
 
-// Values that fill each voxel type's range, negative ones for int16 and
-// float, so that no conversion or sign is left untested.
+// Values in [0, 250) that change along every axis, shifted to [-120, 130)
+// for int16 and float, so that negative voxels are converted too.
 double Pattern(int i, int j, int k) { return std::fmod(37.0 * i + 101.0 * j * j + 53.0 * k + 0.25 * i * k, 250.0); }
 
 template <typename T>
