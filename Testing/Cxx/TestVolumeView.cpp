@@ -73,13 +73,14 @@ std::vector<Vec3> Points(std::array<int, 3> dims, int count) {
       p[a] = x;
       points.push_back(p);
     }
-    // Below 64 and 128 with the last mantissa bit set: p + 1 rounds up.
+    // Just below 64 and 128: p + 1 crosses the power of two, and rounds
+    // where p's last mantissa bit is set (the first of each pair).
     for (float power : {64.f, 128.f}) {
       if (power + 2.f >= (float)dims[a]) continue;
       Vec3 p = middle;
-      p[a] = std::nextafter(power - 1.f, 0.f);
+      p[a] = std::nextafter(power, 0.f);
       points.push_back(p);
-      p[a] = std::nextafter(std::nextafter(power - 1.f, 0.f), 0.f);
+      p[a] = std::nextafter(p[a], 0.f);
       points.push_back(p);
     }
   }
