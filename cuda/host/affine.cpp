@@ -46,11 +46,4 @@ Affine3 AffineCompose(const Affine3& outer, const Affine3& inner) {
   return out;
 }
 
-bool AffineIsIdentity(const Affine3& a, float tolerance) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c)
-      if (std::fabs(a.m[r][c] - (r == c ? 1.f : 0.f)) > tolerance) return false;
-  return true;
-}
-
 }  // namespace mmrtm

@@ -79,15 +79,12 @@ struct Classifier {
   bool onProxy0Grid[kMaxProxies] = {true};
 
   MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world) const {
-    return SampleProxies(world, proxies[0].worldToIndex.ApplyPoint(world));
-  }
-  // `index0`: `world` in proxy 0's index space.
-  MMRTM_CPU_GPU ProxySamples SampleProxies(Vec3 world, Vec3 index0) const {
     ProxySamples s;
-    SampleProxies(world, index0, &s);
+    SampleProxies(world, proxies[0].worldToIndex.ApplyPoint(world), &s);
     return s;
   }
-  // The same into `s` (Classify's own: no temporary to copy per lookup).
+  // The same into `s`, with `index0`, `world` in proxy 0's index space
+  // (Classify's own: the tracker has index0, and no temporary is copied).
   MMRTM_CPU_GPU void SampleProxies(Vec3 world, Vec3 index0, ProxySamples* s) const {
     for (int i = 0; i < proxyCount; ++i)
       s->v[i] = onProxy0Grid[i] ? proxies[i].SampleIndex(index0) : proxies[i].SampleWorld(world);

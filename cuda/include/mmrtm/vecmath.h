@@ -84,7 +84,6 @@ struct Affine3 {
 // Host-only helpers for building transforms.
 Affine3 AffineInverse(const Affine3& a);  // throws std::runtime_error if singular
 Affine3 AffineCompose(const Affine3& outer, const Affine3& inner);  // outer(inner(p))
-bool AffineIsIdentity(const Affine3& a, float tolerance = 1e-6f);
 
 // Orthonormal frame around a unit normal (Duff et al. 2017).
 struct Frame {
