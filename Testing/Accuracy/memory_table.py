@@ -6,10 +6,11 @@
 Renders each dataset once (32 x 32, 1 spp: only the scene's set-up matters)
 and reads the "memory" block of mmrtm-render --stats-json: the proxies'
 voxels as kept (native types, only proxies some TF reads), the majorant grid
-(all levels), the grid's per-leaf value summaries (host only; refits read
-them) and the TF tables, against the input volumes as read. Prints a
-Markdown table, and one of the distinct leaf summaries against the leaves,
-and keeps the numbers in MMRTM_REFERENCE_DIR/memory.json.
+(all levels; a float majorant and a byte minorant per node), the grid's
+per-leaf value summaries (host only; refits read them) and the TF tables,
+against the input volumes as read. Prints a Markdown table, and one of the
+distinct leaf summaries against the leaves, and keeps the numbers in
+MMRTM_REFERENCE_DIR/memory.json.
 """
 
 import json
@@ -37,7 +38,8 @@ def main():
         rows[name] = m
         held = m["bytes_per_voxel"] * m["voxels"]
         print(f"| {name} | {m['voxels']:,.0f} | {m['input_voxel_bytes'] / mib:.1f} | {m['input_bytes_per_voxel']:.2f} | "
-              f"{m['proxy_voxel_bytes'] / mib:.1f} | {m['majorant_bytes'] / mib:.2f} | {m['summary_bytes'] / mib:.1f} | "
+              f"{m['proxy_voxel_bytes'] / mib:.1f} | {(m['majorant_bytes'] + m['minorant_bytes']) / mib:.2f} | "
+              f"{m['summary_bytes'] / mib:.1f} | "
               f"{m['bytes_per_voxel']:.2f} | {held / m['input_voxel_bytes']:.2f} |", flush=True)
     # The summaries' memory follows the distinct leaf summaries (each stored
     # once) and the leaves (an id each).

@@ -54,7 +54,9 @@ inline Estimate Transmittance(const SceneView& s, const Ray& ray, Method method,
   }
   Estimate e;
   e.mean = sum / trials;
-  e.standardError = std::sqrt(std::max(sum2 / trials - e.mean * e.mean, 1e-12) / trials);
+  // At least float rounding: residual ratio tracking in a constant medium
+  // has no variance, and its estimate is exp() in float.
+  e.standardError = std::max(std::sqrt(std::max(sum2 / trials - e.mean * e.mean, 0.0) / trials), 1e-6 * e.mean);
   e.lookupsPerRay = (double)ctr.densityLookups / trials;
   e.violations = ctr.majorantViolations;
   return e;

@@ -65,6 +65,13 @@ TEST(GpuBackend, RefitEqualsTheCpuRefitExactly) {
   }
   EXPECT_EQ(differ, 0);
   EXPECT_GT(nonZero, 0);
+  // The minorant bytes alike (the same SummaryMinorant and UpperNodeBounds).
+  const std::vector<uint8_t> deviceMinorants = gpu.DownloadMinorants();
+  ASSERT_EQ((int64_t)deviceMinorants.size(), grid.NodeCount());
+  const uint8_t* hostMinorants = grid.View().minorants;
+  int64_t minorantsDiffer = 0;
+  for (size_t i = 0; i < deviceMinorants.size(); ++i) minorantsDiffer += deviceMinorants[i] != hostMinorants[i];
+  EXPECT_EQ(minorantsDiffer, 0);
 }
 
 TEST(GpuBackend, ImageMatchesTheCpuImageOfTheSameSeed) {

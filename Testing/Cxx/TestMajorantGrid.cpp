@@ -3,6 +3,9 @@
 //     TFs, no sampled extinction exceeds the majorant the traversal gives
 //     there, and where the traversal skips, the extinction is zero; the
 //     paper's voxel-value refit violates this under a narrow TF peak;
+//   - the minorants (residual ratio tracking's control) are lower bounds:
+//     no sampled extinction is below the minorant the traversal gives there,
+//     with material TFs that leave gaps, and label maps;
 //   - a refit after a TF change (or a data change in a region) equals a full
 //     rebuild;
 //   - unbiased: images with no accelerator, the macrocell grid and the octree
@@ -64,11 +67,12 @@ Scene SceneWith(std::vector<HostVolume> proxies, std::vector<TransferFunctionDes
 
 struct Violations {
   int64_t lookups = 0, overMajorant = 0, inSkippedSpace = 0, segments = 0;
+  int64_t underMinorant = 0, segmentsWithMinorant = 0;
 };
 
 // Random rays through the volume: every point sampled in a segment must have
-// sigma_t * scale <= the segment's majorant; every point the traversal skips
-// must have sigma_t == 0.
+// sigma_min <= sigma_t * scale <= sigma_maj of the segment; every point the
+// traversal skips must have sigma_t == 0.
 Violations CheckAlongRandomRays(const SceneView& s, int rays, float scale, uint64_t seed) {
   Violations v;
   PCG32 rng(seed, 1);
@@ -89,7 +93,7 @@ Violations CheckAlongRandomRays(const SceneView& s, int rays, float scale, uint6
     MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, scale);
     RayMajorantSegment seg;
     float covered = t0;
-    auto check = [&](float a, float b, float majorant, bool skipped) {
+    auto check = [&](float a, float b, float majorant, float minorant, bool skipped) {
       for (int k = 0; k < 8; ++k) {
         const float t = a + (b - a) * ((k + rng.Uniform()) / 8.f);
         // The box test widens [t0, t1] by a few ulps (pbrt's gamma(3)); the
@@ -102,15 +106,17 @@ Violations CheckAlongRandomRays(const SceneView& s, int rays, float scale, uint6
         ++v.lookups;
         if (skipped && sigma > 0.f) ++v.inSkippedSpace;
         if (!skipped && sigma > majorant * (1.f + 1e-5f)) ++v.overMajorant;
+        if (!skipped && sigma < minorant * (1.f - 1e-5f)) ++v.underMinorant;
       }
     };
     while (it.Next(&seg)) {
       ++v.segments;
-      if (seg.tMin > covered) check(covered, seg.tMin, 0.f, true);
-      check(seg.tMin, seg.tMax, seg.sigma_maj, false);
+      if (seg.tMin > covered) check(covered, seg.tMin, 0.f, 0.f, true);
+      check(seg.tMin, seg.tMax, seg.sigma_maj, seg.sigma_min, false);
+      v.segmentsWithMinorant += seg.sigma_min > 0.f;
       covered = std::max(covered, seg.tMax);
     }
-    if (covered < t1) check(covered, t1, 0.f, true);
+    if (covered < t1) check(covered, t1, 0.f, 0.f, true);
   }
   return v;
 }
@@ -137,8 +143,77 @@ TEST_P(Conservative, NarrowPeakStepAndLabelOnRealVolumes) {
       EXPECT_GT(v.segments, 1500);
       EXPECT_EQ(v.overMajorant, 0) << "of " << v.lookups << " lookups";
       EXPECT_EQ(v.inSkippedSpace, 0) << "of " << v.lookups << " lookups";
+      EXPECT_EQ(v.underMinorant, 0) << "of " << v.lookups << " lookups";
     }
   }
+}
+
+// The ct-soft-tissue shape: an MPCTF on CT values picks "skin" on [-450,
+// 200) and "bone" on [gapEnd, 4000), each with a CCTF density; no default, so
+// that air, and the gap [200, gapEnd) when gapEnd > 200, have no material.
+Scene TwoMaterialScene(HostVolume ct, float gapEnd, MajorantKind kind) {
+  Scene s;
+  s.proxies.push_back(std::move(ct));
+  s.tfs.push_back(CCTF({-450.f, -250.f, -50.f, 150.f}, {0.f, 0.5f, 1.f, 1.f}));
+  s.tfs.push_back(CCTF({200.f, 400.f, 800.f}, {0.2f, 0.6f, 1.f}));
+  TransferFunctionDesc pick;
+  pick.where = "test";
+  pick.type = TFType::MPCTF;
+  pick.keys = {-450.f, 200.f, gapEnd, 4000.f};
+  pick.materials = {0, 1};
+  s.tfs.push_back(pick);
+  s.selectors = {2};
+  for (int m = 0; m < 2; ++m) {
+    MaterialDesc d;
+    d.name = m == 0 ? "skin" : "bone";
+    d.base[0] = m == 0 ? 0.15f : 1.5f;
+    d.bindings.push_back({m, Quantity::Density});
+    s.materials.push_back(d);
+  }
+  s.render.accelerator.kind = kind;
+  return s;
+}
+
+TEST_P(Conservative, MinorantsBoundTheExtinctionFromBelow) {
+  // Residual ratio tracking is exact in the minorant's part: a minorant above
+  // the extinction anywhere would bias every shadow ray through it.
+  HostVolume ct = LoadVolume(Data("ct_head_cranium.nrrd"));
+  struct Case {
+    const char* what;
+    Scene scene;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"two materials", TwoMaterialScene(ct, 200.f, GetParam())});
+  // A gap without a material inside the bone ramp: leaves whose values span
+  // it must get 0, although both materials' densities are above 0 there.
+  cases.push_back({"a gap", TwoMaterialScene(ct, 300.f, GetParam())});
+  // A constant density: every non-empty node's minorant is its majorant
+  // (to a 255th).
+  cases.push_back({"constant", SceneWith({ct}, {CCTF({-2000.f, 4000.f}, {1.f, 1.f})}, 0.5f, GetParam())});
+  for (Case& c : cases) {
+    SceneView s = c.scene.Build();
+    // (At a small scale the octree climbs: upper nodes' minorants count.)
+    for (float scale : {1.f, 0.8f, 0.02f}) {
+      Violations v = CheckAlongRandomRays(s, 2000, scale, 13);
+      EXPECT_EQ(v.underMinorant, 0) << c.what << ": of " << v.lookups << " lookups";
+      EXPECT_EQ(v.overMajorant, 0) << c.what << ": of " << v.lookups << " lookups";
+      EXPECT_GT(v.segmentsWithMinorant, v.segments / 20) << c.what << ": the minorants must not all be 0";
+    }
+  }
+}
+
+TEST_P(Conservative, MinorantsUnderALabelMapAndACurve) {
+  // A label's density (nearest lookup, on the labels' own file) times a CT
+  // ramp: the minorant is 0 in leaves with other labels and above 0 only
+  // where the label and the ramp's upper values fill a leaf.
+  HostVolume ct = LoadVolume(Data("cta_chest_aorta.nii.gz"));
+  HostVolume labels = LoadVolume(Data("cta_chest_aorta_labels.nii.gz"), "labels", Interpolation::Nearest);
+  Scene scene = SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({-1000.f, 100.f}, {0.5f, 1.f})}, 5.f,
+                          GetParam());
+  SceneView s = scene.Build();
+  Violations v = CheckAlongRandomRays(s, 1500, 1.f, 17);
+  EXPECT_EQ(v.underMinorant, 0) << "of " << v.lookups << " lookups";
+  EXPECT_GT(v.segmentsWithMinorant, 0) << "the label's interior must have a minorant";
 }
 
 TEST_P(Conservative, SingleLabelTimesCTOnTwoProxies) {
@@ -261,6 +336,7 @@ TEST(Refit, AfterATransferFunctionChangeEqualsAFullRebuild) {
   int nonZero = 0;
   for (int64_t i = 0; i < refitted.Grid()->NodeCount(); ++i) {
     ASSERT_EQ(a.majorants[i], b.majorants[i]) << "node " << i;
+    ASSERT_EQ(a.minorants[i], b.minorants[i]) << "node " << i;
     nonZero += a.majorants[i] > 0.f;
   }
   EXPECT_GT(nonZero, 0);
@@ -268,8 +344,9 @@ TEST(Refit, AfterATransferFunctionChangeEqualsAFullRebuild) {
 }
 
 TEST(Refit, ByteTablesGiveTheSameLeafMajorantsAsTheBins) {
-  // The CPU refit takes each leaf's maximum through per-byte tables; the
-  // CUDA refit walks the set bins. Both must give every leaf the same value.
+  // The CPU refit takes each leaf's maximum (and minimum) through per-byte
+  // tables; the CUDA refit walks the set bins. Both must give every leaf
+  // the same values.
   HostVolume ct = LoadVolume(Data("ct_head_headsq.nrrd"));
   Scene scene = SceneWith({ct}, {CCTF({300.f, 700.f, 900.f, 1400.f, 2600.f}, {0.f, 0.9f, 0.1f, 1.f, 0.3f})}, 2.f,
                           MajorantKind::Octree);
@@ -280,14 +357,21 @@ TEST(Refit, ByteTablesGiveTheSameLeafMajorantsAsTheBins) {
   bins.summaries[0] = bytes.summaries[0] = grid.Summaries().Words(0);
   bins.binMax = bytes.binMax = tables.binMax.data();
   bins.binMaterials = bytes.binMaterials = tables.binMaterials.data();
+  bins.binMin = bytes.binMin = tables.binMin.data();
+  bins.uncoveredBins = bytes.uncoveredBins = tables.uncoveredBins.data();
   bytes.byteMax = tables.byteMax.data();
-  int nonZero = 0;
+  bytes.byteMin = tables.byteMin.data();
+  int nonZero = 0, nonZeroMinorants = 0;
   for (int64_t s = 0; s < (int64_t)grid.Summaries().Count(); ++s) {
     const float a = SummaryMajorant(view.classifier, bins, s), b = SummaryMajorant(view.classifier, bytes, s);
     ASSERT_EQ(a, b) << "summary " << s;
     nonZero += a > 0.f;
+    const float lowerA = SummaryMinorant(view.classifier, bins, s), lowerB = SummaryMinorant(view.classifier, bytes, s);
+    ASSERT_EQ(lowerA, lowerB) << "summary " << s;
+    nonZeroMinorants += lowerA > 0.f;
   }
   EXPECT_GT(nonZero, 100);
+  EXPECT_GT(nonZeroMinorants, 10);
 }
 
 // Proxy k's summary words of a leaf.

@@ -82,6 +82,7 @@ TEST(SceneRelocation, FootprintCountsEveryKind) {
   const SceneFootprint f = MeasureSceneView(scene.Build());
   EXPECT_EQ(f.voxels, scene.proxies[0].voxels.size() + scene.proxies[1].voxels.size());
   EXPECT_EQ(f.majorants, (size_t)scene.Grid()->NodeCount() * sizeof(float));
+  EXPECT_EQ(f.minorants, (size_t)scene.Grid()->NodeCount());  // a byte each
   EXPECT_GT(f.tables, 0u);
   EXPECT_GT(f.environment, 0u);
 }

@@ -1,7 +1,8 @@
 // Transmittance of slabs against Beer-Lambert, by delta tracking (the
-// probability of crossing without a real collision) and by ratio tracking
-// (the mean of its estimates). Tolerances are 4 standard errors of each
-// estimator, computed from the estimator's own variance.
+// probability of crossing without a real collision) and by residual ratio
+// tracking (the mean of its estimates). Tolerances are 4 standard errors of
+// each estimator, computed from the estimator's own variance (and at least
+// float rounding, for an estimator without variance).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,9 +30,10 @@ Estimate DeltaTransmittance(const SceneView& s, Ray ray, float tMax) {
   return {p, std::sqrt(std::max(p * (1 - p), 1e-12) / kTrials)};
 }
 
-Estimate RatioTransmittance(const SceneView& s, Ray ray, float tMax, float scale) {
+Estimate RatioTransmittance(const SceneView& s, Ray ray, float tMax, float scale, TraceCounters* counters = nullptr) {
   PCG32 rng(3, 4);
-  TraceCounters ctr;
+  TraceCounters local;
+  TraceCounters& ctr = counters ? *counters : local;
   double sum = 0, sum2 = 0;
   for (int i = 0; i < kTrials; ++i) {
     double T = RatioTrack(s, ray, tMax, scale, rng, ctr);
@@ -40,7 +42,7 @@ Estimate RatioTransmittance(const SceneView& s, Ray ray, float tMax, float scale
   }
   double mean = sum / kTrials;
   EXPECT_EQ(ctr.majorantViolations, 0u);
-  return {mean, std::sqrt(std::max(sum2 / kTrials - mean * mean, 1e-12) / kTrials)};
+  return {mean, std::max(std::sqrt(std::max(sum2 / kTrials - mean * mean, 0.0) / kTrials), 1e-6 * mean)};
 }
 
 TEST(Tracking, HomogeneousSlabFollowsBeerLambert) {
@@ -74,6 +76,48 @@ TEST(Tracking, LinearRampFollowsBeerLambert) {
   EXPECT_NEAR(d.mean, expected, kSigmas * d.standardError);
   Estimate r = RatioTransmittance(s, ray, kInfinity, 1.f);
   EXPECT_NEAR(r.mean, expected, kSigmas * r.standardError);
+}
+
+TEST(Tracking, ResidualRatioTrackingIsExactWhereTheExtinctionIsConstant) {
+  // The grid's minorant equals its majorant in a constant medium: the
+  // control part exp(-sigma_min * length) is all of the transmittance, every
+  // estimate is exact, and no lookup is needed.
+  // (A transmittance above the roulette's threshold: 0.2. A TF constant
+  // over all values: the summaries' first bin also holds every value below
+  // the volume's, where an identity TF would go down to 0.)
+  Scene scene = test::MakeMediumScene(test::MakeConstantVolume(33, 1.f, 0.5f), 0.1f, RGB(1.f));
+  for (float& v : scene.tfs[0].values) v = 1.f;
+  SceneView s = scene.Build();
+  const Ray ray{{-5.f, 8.f, 8.f}, {1.f, 0.f, 0.f}};
+  PCG32 rng(7, 8);
+  TraceCounters ctr;
+  for (int i = 0; i < 1000; ++i) ASSERT_NEAR(RatioTrack(s, ray, kInfinity, 1.f, rng, ctr), std::exp(-0.1 * 16.0), 1e-6);
+  EXPECT_EQ(ctr.densityLookups, 0u);
+}
+
+TEST(Tracking, ResidualRatioTrackingHasLessVarianceThanRatioTracking) {
+  // The ramp of LinearRampFollowsBeerLambert: plain ratio tracking (the
+  // same view without minorants) and residual ratio tracking both agree
+  // with Beer-Lambert; the residual one with less variance and fewer lookups.
+  const int n = 21;
+  Scene scene = test::MakeMediumScene(
+      test::MakeVolume(n, 5, 5, [](int i, int, int) { return i / 20.f; }), 0.4f, RGB(1.f));
+  SceneView residual = scene.Build();
+  ASSERT_NE(residual.majorants.grid.minorants, nullptr);
+  SceneView plain = residual;
+  plain.majorants.grid.minorants = nullptr;
+  const Ray ray{{-1.f, 2.f, 2.f}, {1.f, 0.f, 0.f}};
+  // Half the ramp: optical depth 0.5 * 0.2 * 10 = 1, so that roulette
+  // (below a transmittance of 0.1) plays little part.
+  const double expected = std::exp(-1.0);
+  TraceCounters plainCounters, residualCounters;
+  Estimate p = RatioTransmittance(plain, ray, 1.f + 10.f, 1.f, &plainCounters);
+  Estimate r = RatioTransmittance(residual, ray, 1.f + 10.f, 1.f, &residualCounters);
+  EXPECT_NEAR(p.mean, expected, kSigmas * p.standardError);
+  EXPECT_NEAR(r.mean, expected, kSigmas * r.standardError);
+  EXPECT_LT(r.standardError, 0.5 * p.standardError);
+  // (Measured: 0.40 times the standard error, 0.51 times the lookups.)
+  EXPECT_LT(residualCounters.densityLookups, plainCounters.densityLookups * 6 / 10);
 }
 
 TEST(Tracking, ObliqueRayInRotatedVolume) {

@@ -182,6 +182,68 @@ TEST(TransferFunction, MaxOverRangeBoundsPeaksBetweenEndpoints) {
   EXPECT_FLOAT_EQ(m, 0.f);
 }
 
+TEST(TransferFunction, MinOverRangeBoundsEveryValueFromBelow) {
+  // The minorants' bound (majorant_refit.h): at most the TF anywhere in
+  // [lo, hi], and for a CCTF the minimum itself (a valley between keys).
+  Scene s;
+  SceneView v = BuildWith(s, {Coefficient(TFType::CCTF, 0, 1, {0, 10, 20, 30}, {1, 0.2f, 0.8f, 0.5f}),
+                              Coefficient(TFType::CPCTF, 0, 1, {0, 10, 10, 20, 25, 30}, {0.5f, 0.7f, 0.9f}),
+                              Coefficient(TFType::CDPTF, 0, 1, {3, 4, 5, 9}, {0.25f, 0.75f, 0.5f, 1.f})});
+  float m;
+  v.classifier.tfs[0].MinOverRange(5, 15, &m);
+  EXPECT_FLOAT_EQ(m, 0.2f);  // the key at 10, not an endpoint
+  v.classifier.tfs[1].MinOverRange(5, 15, &m);
+  EXPECT_FLOAT_EQ(m, 0.5f);  // [0, 10) and [10, 20) cover [5, 15]
+  v.classifier.tfs[1].MinOverRange(15, 26, &m);
+  EXPECT_FLOAT_EQ(m, 0.f);  // the gap [20, 25) is 0
+  v.classifier.tfs[2].MinOverRange(2.6f, 5.4f, &m);
+  EXPECT_FLOAT_EQ(m, 0.25f);  // rounds to 3..5, all keys
+  v.classifier.tfs[2].MinOverRange(2.6f, 6.f, &m);
+  EXPECT_FLOAT_EQ(m, 0.f);  // 6 has no key
+  // Random intervals against a dense evaluation.
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> x(-5.f, 35.f);
+  for (int t = 0; t < 3; ++t) {
+    const TransferFunctionView& tf = v.classifier.tfs[t];
+    for (int trial = 0; trial < 2000; ++trial) {
+      float lo = x(gen), hi = x(gen);
+      if (lo > hi) std::swap(lo, hi);
+      float bound;
+      tf.MinOverRange(lo, hi, &bound);
+      float least = Eval1(tf, hi);
+      // (Clamped to hi: lo + (hi - lo) can round past it.)
+      for (int k = 0; k <= 400; ++k) least = std::min(least, Eval1(tf, std::min(hi, lo + (hi - lo) * k / 400.f)));
+      EXPECT_LE(bound, least) << "tf " << t << " over [" << lo << ", " << hi << "]";
+      if (t == 0) EXPECT_NEAR(bound, least, 0.02f) << "a CCTF's bound is its minimum";
+    }
+  }
+}
+
+TEST(TransferFunction, CoversRangeSaysWhetherEveryValueHasAnEntry) {
+  Scene s;
+  for (const char* n : {"a", "b"}) {
+    MaterialDesc m;
+    m.name = n;
+    s.materials.push_back(m);
+  }
+  s.defaultMaterial = 0;
+  SceneView v = BuildWith(s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}),
+                              MaterialTF(TFType::MPCTF, 0, {4, 10, 0, 6}, {0, 1}),
+                              MaterialTF(TFType::MDPTF, 0, {2, 3, 4, 7}, {0, 1, 0, 1}),
+                              Coefficient(TFType::CCTF, 0, 1, {0, 1}, {0, 1})});
+  const TransferFunctionView &adjacent = v.classifier.tfs[0], &overlapping = v.classifier.tfs[1],
+                             &labels = v.classifier.tfs[2], &curve = v.classifier.tfs[3];
+  EXPECT_TRUE(adjacent.CoversRange(0.f, 7.9f));
+  EXPECT_FALSE(adjacent.CoversRange(0.f, 8.f));  // [5, 8) stops short of 8
+  EXPECT_FALSE(adjacent.CoversRange(-1.f, 3.f));
+  EXPECT_TRUE(overlapping.CoversRange(0.f, 9.9f));  // ranges listed out of order
+  EXPECT_FALSE(overlapping.CoversRange(9.f, 10.f));
+  EXPECT_TRUE(labels.CoversRange(1.6f, 4.4f));  // rounds to 2..4
+  EXPECT_FALSE(labels.CoversRange(1.6f, 5.f));  // 5 has no entry
+  EXPECT_TRUE(labels.CoversRange(7.f, 7.f));
+  EXPECT_TRUE(curve.CoversRange(-100.f, 100.f));
+}
+
 // Two proxies: "scalars" (value 300 everywhere) and "labels" (1 in the lower
 // half of x, 0 elsewhere), for the merge rules.
 struct MergeScene {

@@ -44,23 +44,28 @@ __global__ void RenderSampleKernel(SceneView scene, FilmView film, uint32_t inde
   add(&counters->majorantViolations, ctr.majorantViolations);
 }
 
-__global__ void RefitSummariesKernel(Classifier c, RefitInputs in, float* bounds, int64_t summaries) {
+__global__ void RefitSummariesKernel(Classifier c, RefitInputs in, float* bounds, uint8_t* lowerBounds,
+                                     int64_t summaries) {
   const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (s < summaries) bounds[s] = SummaryMajorant(c, in, s);
+  if (s >= summaries) return;
+  bounds[s] = SummaryMajorant(c, in, s);
+  lowerBounds[s] = EncodeMinorant(bounds[s], SummaryMinorant(c, in, s));
 }
 
-__global__ void RefitLeavesKernel(const float* bounds, const uint32_t* leafSummaryIds, float* majorants,
-                                  int64_t leafOffset, int64_t leaves) {
+__global__ void RefitLeavesKernel(const float* bounds, const uint8_t* lowerBounds, const uint32_t* leafSummaryIds,
+                                  float* majorants, uint8_t* minorants, int64_t leafOffset, int64_t leaves) {
   const int64_t leaf = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (leaf < leaves) majorants[leafOffset + leaf] = bounds[leafSummaryIds[leaf]];
+  if (leaf >= leaves) return;
+  majorants[leafOffset + leaf] = bounds[leafSummaryIds[leaf]];
+  minorants[leafOffset + leaf] = lowerBounds[leafSummaryIds[leaf]];
 }
 
-__global__ void RefitLevelKernel(MajorantGridView g, float* majorants, int level) {
+__global__ void RefitLevelKernel(MajorantGridView g, float* majorants, uint8_t* minorants, int level) {
   const int64_t i = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
   const int* r = g.res[level];
   if (i >= (int64_t)r[0] * r[1] * r[2]) return;
   const int x = (int)(i % r[0]), y = (int)((i / r[0]) % r[1]), z = (int)(i / ((int64_t)r[0] * r[1]));
-  majorants[g.Index(level, x, y, z)] = UpperNodeMajorant(g, majorants, level, x, y, z);
+  UpperNodeBounds(g, majorants, minorants, level, x, y, z);
 }
 
 int Blocks(int64_t n, int threads) { return (int)((n + threads - 1) / threads); }
@@ -74,8 +79,10 @@ struct GpuRenderer::Impl {
   std::map<std::pair<const void*, size_t>, DeviceBuffer> voxels;
   std::vector<DeviceBuffer> tables;  // everything else, replaced on every SetScene
   float* majorants = nullptr;        // inside `tables`
+  uint8_t* minorants = nullptr;      // inside `tables`, as many
   size_t majorantCount = 0;
-  DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, binMax, binMaterials;
+  DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, summaryLowerBounds, binMax, binMaterials,
+      binMin, uncoveredBins;
   DeviceBuffer filmMean, filmM2, filmEven, filmWork, counters, rangeFirst, rangeEnd;
   int filmWidth = 0, filmHeight = 0;
   uint32_t filmSamples = 0;
@@ -178,6 +185,7 @@ void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
   std::vector<DeviceBuffer> tables;
   std::map<std::pair<const void*, size_t>, DeviceBuffer> voxels;
   float* majorants = nullptr;
+  uint8_t* minorants = nullptr;
   m.device = RelocateSceneView(view, [&](const void* host, size_t bytes, SceneArrayKind kind) -> const void* {
     if (kind == SceneArrayKind::Voxels) {
       const auto key = std::make_pair(host, bytes);
@@ -188,21 +196,24 @@ void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
       b.Upload(host, bytes);
       return b.Get();
     }
-    tables.emplace_back(bytes, kind == SceneArrayKind::Majorants ? "majorants" : "scene tables");
+    const bool grid = kind == SceneArrayKind::Majorants || kind == SceneArrayKind::Minorants;
+    tables.emplace_back(bytes, grid ? "majorants" : "scene tables");
     tables.back().Upload(host, bytes);
     if (kind == SceneArrayKind::Majorants) majorants = tables.back().As<float>();
+    if (kind == SceneArrayKind::Minorants) minorants = tables.back().As<uint8_t>();
     return tables.back().Get();
   });
   m.voxels = std::move(voxels);
   m.tables = std::move(tables);
   m.majorants = majorants;
+  m.minorants = minorants;
   m.majorantCount = footprint.majorants / sizeof(float);
   m.hasScene = true;
 }
 
 void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, bool summariesChanged) {
   Impl& m = *impl_;
-  if (!m.hasScene || !m.majorants) throw CudaError("GpuRenderer::Refit: the uploaded scene has no majorant grid");
+  if (!m.hasScene || !m.majorants || !m.minorants) throw CudaError("GpuRenderer::Refit: the uploaded scene has no majorant grid");
   if ((size_t)grid.NodeCount() != m.majorantCount)
     throw CudaError("GpuRenderer::Refit: the grid does not match the uploaded scene");
   RefitInputs in;
@@ -217,6 +228,7 @@ void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, 
     m.leafSummaryIds.Allocate(ids.size() * sizeof(uint32_t), "majorant summaries");
     m.leafSummaryIds.Upload(ids.data(), ids.size() * sizeof(uint32_t));
     m.summaryBounds.Allocate(table.Count() * sizeof(float), "majorant summaries");
+    m.summaryLowerBounds.Allocate(table.Count() * sizeof(uint8_t), "majorant summaries");
   }
   for (int k = 0; k < grid.ProxyCount(); ++k) {
     const std::vector<uint64_t>& s = table.WordVector(k);
@@ -231,28 +243,41 @@ void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, 
   m.binMax.Upload(t.binMax.data(), t.binMax.size() * sizeof(float));
   m.binMaterials.Allocate(t.binMaterials.size() * sizeof(uint64_t), "refit tables");
   m.binMaterials.Upload(t.binMaterials.data(), t.binMaterials.size() * sizeof(uint64_t));
+  m.binMin.Allocate(t.binMin.size() * sizeof(float), "refit tables");
+  m.binMin.Upload(t.binMin.data(), t.binMin.size() * sizeof(float));
+  m.uncoveredBins.Allocate(t.uncoveredBins.size() * sizeof(uint64_t), "refit tables");
+  m.uncoveredBins.Upload(t.uncoveredBins.data(), t.uncoveredBins.size() * sizeof(uint64_t));
   in.binMax = m.binMax.As<float>();
   in.binMaterials = m.binMaterials.As<uint64_t>();
+  in.binMin = m.binMin.As<float>();
+  in.uncoveredBins = m.uncoveredBins.As<uint64_t>();
   in.materialMasks = t.materialMasks;
 
   const MajorantGridView& g = m.device.majorants.grid;
   constexpr int kThreads = 256;
   const int64_t summaries = (int64_t)table.Count();
   if (summaries > 0) {
-    RefitSummariesKernel<<<Blocks(summaries, kThreads), kThreads>>>(m.device.classifier, in,
-                                                                   m.summaryBounds.As<float>(), summaries);
+    RefitSummariesKernel<<<Blocks(summaries, kThreads), kThreads>>>(
+        m.device.classifier, in, m.summaryBounds.As<float>(), m.summaryLowerBounds.As<uint8_t>(), summaries);
     MMRTM_CUDA_CHECK(cudaGetLastError());
   }
-  RefitLeavesKernel<<<Blocks(leaves, kThreads), kThreads>>>(m.summaryBounds.As<float>(),
-                                                            m.leafSummaryIds.As<uint32_t>(), m.majorants,
-                                                            g.offset[g.leafLevel], leaves);
+  RefitLeavesKernel<<<Blocks(leaves, kThreads), kThreads>>>(
+      m.summaryBounds.As<float>(), m.summaryLowerBounds.As<uint8_t>(), m.leafSummaryIds.As<uint32_t>(), m.majorants,
+      m.minorants, g.offset[g.leafLevel], leaves);
   MMRTM_CUDA_CHECK(cudaGetLastError());
   for (int level = g.leafLevel - 1; level >= 0; --level) {
     const int64_t nodes = (int64_t)g.res[level][0] * g.res[level][1] * g.res[level][2];
-    RefitLevelKernel<<<Blocks(nodes, kThreads), kThreads>>>(g, m.majorants, level);
+    RefitLevelKernel<<<Blocks(nodes, kThreads), kThreads>>>(g, m.majorants, m.minorants, level);
     MMRTM_CUDA_CHECK(cudaGetLastError());
   }
   MMRTM_CUDA_CHECK(cudaDeviceSynchronize());
+}
+
+std::vector<uint8_t> GpuRenderer::DownloadMinorants() const {
+  std::vector<uint8_t> out(impl_->minorants ? impl_->majorantCount : 0);
+  if (!out.empty())
+    MMRTM_CUDA_CHECK(cudaMemcpy(out.data(), impl_->minorants, out.size(), cudaMemcpyDeviceToHost));
+  return out;
 }
 
 std::vector<float> GpuRenderer::DownloadMajorants() const {

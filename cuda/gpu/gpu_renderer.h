@@ -39,8 +39,9 @@ class GpuRenderer {
   // built with (its summaries go up when `summariesChanged`), `classifier`
   // the host classifier (its TFs give the per-bin tables).
   void Refit(const MajorantGrid& grid, const Classifier& classifier, bool summariesChanged);
-  // The device majorants, level after level (for tests).
+  // The device majorants, level after level, and the minorant bytes (for tests).
   std::vector<float> DownloadMajorants() const;
+  std::vector<uint8_t> DownloadMinorants() const;
 
   // Adds `samplesPerPixel` samples to every pixel, accumulating on the
   // device, and copies the accumulation into `film` at the end. Sample

@@ -142,6 +142,8 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
   }
   majorants_.assign(offset, 0.f);
   view_.majorants = majorants_.data();
+  minorants_.assign(offset, 0);
+  view_.minorants = minorants_.data();
 
   // Value bins per proxy, and the map from proxy 0's index space to each proxy's.
   for (int k = 0; k < proxyCount_; ++k) {
@@ -318,6 +320,9 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
   t.binMax.assign((size_t)c.tfCount * kSummaryBins, 0.f);
   t.byteMax.assign((size_t)c.tfCount * kSummaryBytes * 256, 0.f);
   t.binMaterials.assign((size_t)c.tfCount * kSummaryBins, 0);
+  t.binMin.assign((size_t)c.tfCount * kSummaryBins, 0.f);
+  t.byteMin.assign((size_t)c.tfCount * kSummaryBytes * 256, kInfinity);
+  t.uncoveredBins.assign((size_t)c.tfCount * kSummaryWords, 0);
   t.materialMasks = c.materialCount <= 64;
   // The refit reads the byte tables of density TFs only.
   std::vector<char> density((size_t)c.tfCount, 0);
@@ -334,18 +339,25 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
         for (int e = 0; e < tf.count; ++e)
           if (tf.EntryInRange(e, lo, hi)) mask |= 1ull << (tf.materials[e] & 63);
         t.binMaterials[(size_t)i * kSummaryBins + b] = mask;
+        if (!tf.CoversRange(lo, hi)) t.uncoveredBins[(size_t)i * kSummaryWords + b / 64] |= 1ull << (b % 64);
       } else {
         float v[kMaxTFChannels];
         tf.MaxOverRange(lo, hi, v);
         t.binMax[(size_t)i * kSummaryBins + b] = v[0];
+        tf.MinOverRange(lo, hi, v);
+        t.binMin[(size_t)i * kSummaryBins + b] = v[0];
       }
     }
-    // Each byte value's maximum: that of the value without its lowest bit,
-    // and that bit's bin (32 x 255 entries a TF).
+    // Each byte value's maximum (minimum): that of the value without its
+    // lowest bit, and that bit's bin (32 x 255 entries a TF).
     for (int byte = 0; byte < kSummaryBytes && density[(size_t)i] && !IsMaterialTF(tf.type); ++byte) {
       float* table = &t.byteMax[((size_t)i * kSummaryBytes + byte) * 256];
-      for (int v = 1; v < 256; ++v)
-        table[v] = std::max(table[v & (v - 1)], t.binMax[(size_t)i * kSummaryBins + byte * 8 + CountTrailingZeros64(v)]);
+      float* lower = &t.byteMin[((size_t)i * kSummaryBytes + byte) * 256];
+      for (int v = 1; v < 256; ++v) {
+        const size_t bin = (size_t)i * kSummaryBins + byte * 8 + CountTrailingZeros64(v);
+        table[v] = std::max(table[v & (v - 1)], t.binMax[bin]);
+        lower[v] = std::min(lower[v & (v - 1)], t.binMin[bin]);
+      }
     }
   }
   return t;
@@ -354,6 +366,7 @@ MajorantGrid::RefitTables MajorantGrid::MakeRefitTables(const Classifier& c) con
 void MajorantGrid::Refit(const Classifier& c) {
   const auto start = Clock::now();
   if (options_.summary == SummaryMode::VoxelValues) {
+    std::fill(minorants_.begin(), minorants_.end(), 0);  // no lower bounds from voxel values
     RefitFromVoxelValues(c);
     RefitUpperLevels();
     refitSeconds_ = SecondsSince(start);
@@ -366,29 +379,42 @@ void MajorantGrid::Refit(const Classifier& c) {
   in.binMaterials = tables.binMaterials.data();
   in.materialMasks = tables.materialMasks;
   in.byteMax = tables.byteMax.data();
+  in.binMin = tables.binMin.data();
+  in.uncoveredBins = tables.uncoveredBins.data();
+  in.byteMin = tables.byteMin.data();
   // Each distinct summary (the same function as the CUDA refit), its leaves,
   // then the levels above.
   std::vector<float> bounds(summaries_.Count());
+  std::vector<uint8_t> lowerBounds(summaries_.Count());
   ParallelFor((int64_t)bounds.size(), options_.threads, [&](int64_t begin, int64_t end) {
-    for (int64_t s = begin; s < end; ++s) bounds[(size_t)s] = SummaryMajorant(c, in, s);
+    for (int64_t s = begin; s < end; ++s) {
+      bounds[(size_t)s] = SummaryMajorant(c, in, s);
+      lowerBounds[(size_t)s] = EncodeMinorant(bounds[(size_t)s], SummaryMinorant(c, in, s));
+    }
   });
   float* leafMajorants = majorants_.data() + view_.offset[view_.leafLevel];
+  uint8_t* leafMinorants = minorants_.data() + view_.offset[view_.leafLevel];
   ParallelFor(LeafCount(), options_.threads, [&](int64_t begin, int64_t end) {
-    for (int64_t leaf = begin; leaf < end; ++leaf) leafMajorants[leaf] = bounds[leafSummaryIds_[(size_t)leaf]];
+    for (int64_t leaf = begin; leaf < end; ++leaf) {
+      leafMajorants[leaf] = bounds[leafSummaryIds_[(size_t)leaf]];
+      leafMinorants[leaf] = lowerBounds[leafSummaryIds_[(size_t)leaf]];
+    }
   });
   RefitUpperLevels();
   refitSeconds_ = SecondsSince(start);
 }
 
 void MajorantGrid::RefitUpperLevels() {
-  // Bottom-up: each node the maximum of its children.
+  // Bottom-up: each node the maximum of its children, and the least of their
+  // minorants; a level's nodes in parallel where there are many.
   for (int l = view_.leafLevel - 1; l >= 0; --l) {
     const int* r = view_.res[l];
-    for (int z = 0; z < r[2]; ++z)
-      for (int y = 0; y < r[1]; ++y)
-        for (int x = 0; x < r[0]; ++x) {
-          majorants_[view_.Index(l, x, y, z)] = UpperNodeMajorant(view_, majorants_.data(), l, x, y, z);
-        }
+    const int64_t rows = (int64_t)r[1] * r[2];
+    ParallelFor(rows, rows * r[0] >= 32768 ? options_.threads : 1, [&](int64_t begin, int64_t end) {
+      for (int64_t row = begin; row < end; ++row)
+        for (int x = 0; x < r[0]; ++x)
+          UpperNodeBounds(view_, majorants_.data(), minorants_.data(), l, x, (int)(row % r[1]), (int)(row / r[1]));
+    });
   }
 }
 

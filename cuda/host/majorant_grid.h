@@ -31,6 +31,11 @@
 // maximum over the summary's bins; each leaf takes its summary's bound, then
 // every parent the maximum of its children. The cost depends on the number
 // of distinct summaries, leaves and bins, not on the number of voxels.
+//
+// Minorants alike (SummaryMinorant): per distinct summary a lower bound of
+// the extinction, from each density TF's minimum over the summary's bins
+// (0 where a point may have no material); every parent the least of its
+// children's. Residual ratio tracking uses them (tracking.h).
 #pragma once
 
 #include <array>
@@ -86,6 +91,12 @@ class MajorantGrid {
     // binMax by byte of a summary (RefitInputs::byteMax): the CPU refit's
     // shortcut; the CUDA refit walks the bits.
     std::vector<float> byteMax;
+    // Minorants: per TF and bin MinOverRange (coefficient TFs), and per TF
+    // the mask of the bins a material TF does not cover (CoversRange);
+    // byteMin as byteMax.
+    std::vector<float> binMin;
+    std::vector<uint64_t> uncoveredBins;
+    std::vector<float> byteMin;
   };
   RefitTables MakeRefitTables(const Classifier& classifier) const;
   // The distinct leaf summaries, and each leaf's id among them (both empty
@@ -96,6 +107,8 @@ class MajorantGrid {
   size_t SummaryBytes() const { return summaries_.Bytes() + leafSummaryIds_.capacity() * sizeof(uint32_t); }
   int ProxyCount() const { return proxyCount_; }
   const MajorantGridView& View() const { return view_; }
+  // Each node's lower bound of sigma_t (DecodeMinorant of its byte).
+  float Minorant(int64_t node) const { return DecodeMinorant(majorants_[(size_t)node], minorants_[(size_t)node]); }
   int LeafLevel() const { return view_.leafLevel; }
   int64_t LeafCount() const;
   int64_t NodeCount() const { return (int64_t)majorants_.size(); }
@@ -136,6 +149,7 @@ class MajorantGrid {
   LeafSummaryTable summaries_;
   std::vector<uint32_t> leafSummaryIds_;  // per leaf
   std::vector<float> majorants_;
+  std::vector<uint8_t> minorants_;  // indexed as majorants_ (MajorantGridView::minorants)
   double buildSeconds_ = 0, refitSeconds_ = 0;
 };
 

@@ -14,6 +14,7 @@ namespace mmrtm {
 
 struct RayMajorantSegment {
   float tMin = 0.f, tMax = 0.f, sigma_maj = 0.f;
+  float sigma_min = 0.f;  // a lower bound of sigma_t over the segment (0: none known)
 };
 
 enum class MajorantKind : uint8_t { Global, Macrocell, Octree };
@@ -37,7 +38,7 @@ class MajorantIterator {
   }
 
   MMRTM_CPU_GPU bool Next(RayMajorantSegment* seg) {
-    if (isGrid_) return grid_.Next(&seg->tMin, &seg->tMax, &seg->sigma_maj);
+    if (isGrid_) return grid_.Next(&seg->tMin, &seg->tMax, &seg->sigma_maj, &seg->sigma_min);
     if (!pending_) return false;
     *seg = single_;
     pending_ = false;

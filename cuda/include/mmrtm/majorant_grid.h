@@ -47,6 +47,11 @@ struct MajorantGridView {
   int64_t offset[kMaxGridLevels] = {};     // first node of each level in `majorants`
   float worldWidth[kMaxGridLevels] = {};   // node width in world units (largest axis)
   const float* majorants = nullptr;        // sigma_t bound of every node, level after level
+  // A lower bound of sigma_t in every node, indexed as `majorants`, as a
+  // fraction of the node's majorant in 255ths (DecodeMinorant): the control
+  // of residual ratio tracking (tracking.h). A byte, not a float, so that
+  // the grid grows by a quarter and not by half; null: 0 everywhere.
+  const uint8_t* minorants = nullptr;
 
   MMRTM_CPU_GPU int64_t Index(int level, int x, int y, int z) const {
     MMRTM_DCHECK(x >= 0 && x < res[level][0] && y >= 0 && y < res[level][1] && z >= 0 && z < res[level][2]);
@@ -54,6 +59,21 @@ struct MajorantGridView {
   }
   MMRTM_CPU_GPU float Majorant(int level, const int c[3]) const { return majorants[Index(level, c[0], c[1], c[2])]; }
 };
+
+// A node's minorant from its majorant and its byte (MajorantGridView::minorants).
+// 255 gives the majorant itself, so that a constant node's residual is
+// exactly 0 (255 * (1 / 255.f) rounds below 1).
+MMRTM_CPU_GPU inline float DecodeMinorant(float majorant, uint8_t fraction) {
+  return fraction == 255 ? majorant : majorant * ((float)fraction * (1.f / 255.f));
+}
+// The largest byte whose decoded minorant stays at most `minorant` (0 when
+// either bound is 0 or NaN): rounding down keeps it a lower bound.
+MMRTM_CPU_GPU inline uint8_t EncodeMinorant(float majorant, float minorant) {
+  if (!(majorant > 0.f) || !(minorant > 0.f)) return 0;
+  int q = minorant >= majorant ? 255 : (int)(255.f * (minorant / majorant));
+  while (q > 0 && DecodeMinorant(majorant, (uint8_t)q) > minorant) --q;
+  return (uint8_t)q;
+}
 
 // Walks the grid along a ray given in voxel index space (its parameter t is
 // the world distance), handing out majorant segments.
@@ -85,8 +105,9 @@ class GridMajorantIterator {
     EnterLevel();
   }
 
-  // The next segment with a non-zero majorant; false at the end of the ray.
-  MMRTM_CPU_GPU bool Next(float* tMin, float* tMax, float* sigma_maj) {
+  // The next segment with a non-zero majorant, and a lower bound of the
+  // extinction over it (0 without minorants); false at the end of the ray.
+  MMRTM_CPU_GPU bool Next(float* tMin, float* tMax, float* sigma_maj, float* sigma_min) {
     while (t_ < tEnd_) {
       const float maj = grid_->majorants[node_];
       if (maj <= 0.f) {
@@ -114,6 +135,7 @@ class GridMajorantIterator {
       const float tExit = ExitDistance(&axis);
       *tMin = t_;
       *sigma_maj = maj * scale_;
+      *sigma_min = grid_->minorants ? DecodeMinorant(*sigma_maj, grid_->minorants[node_]) : 0.f;
       // The last node of the ray takes the rest of [tMin, tMax]: the box test
       // widens the far end by a few ulps, where lookups clamp to this node.
       *tMax = Step(axis, tExit) ? tExit : tEnd_;

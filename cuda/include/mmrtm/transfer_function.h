@@ -122,6 +122,62 @@ struct TransferFunctionView {
     }
   }
 
+  // Coefficient TFs: a lower bound of every channel over all x in [lo, hi]
+  // (the minimum for a CCTF; 0 where a range or discrete TF may have no
+  // entry): what makes minorants conservative, as MaxOverRange majorants.
+  MMRTM_CPU_GPU void MinOverRange(float lo, float hi, float* out) const {
+    if (type != TFType::CCTF && !CoversRange(lo, hi)) {
+      for (int c = 0; c < channels; ++c) out[c] = 0.f;
+      return;
+    }
+    bool first = true;
+    float tmp[kMaxTFChannels];
+    if (type == TFType::CCTF) {
+      Evaluate(lo, out);
+      Evaluate(hi, tmp);
+      AccumulateMin(tmp, out);
+      first = false;
+    }
+    for (int i = 0; i < count; ++i) {
+      if (!EntryInRange(i, lo, hi)) continue;
+      if (first) Copy(i, out); else AccumulateMin(values + i * channels, out);
+      first = false;
+    }
+    if (first)
+      for (int c = 0; c < channels; ++c) out[c] = 0.f;
+  }
+
+  // Range and discrete TFs: whether every x in [lo, hi] has an entry (a
+  // material TF names a material there; a coefficient TF is not 0 by
+  // default). Discrete TFs check each integer, up to kMaxCoverageChecks of
+  // them (beyond: false, which only loosens a minorant). A CCTF covers all.
+  static constexpr int kMaxCoverageChecks = 256;
+  MMRTM_CPU_GPU bool CoversRange(float lo, float hi) const {
+    if (type == TFType::CCTF) return true;
+    if (!(lo <= hi)) return false;
+    if (IsDiscreteTF(type)) {
+      const float r0 = floorf(lo + 0.5f), r1 = floorf(hi + 0.5f);
+      if (r1 - r0 >= (float)kMaxCoverageChecks) return false;
+      for (float r = r0; r <= r1; r += 1.f)
+        if (FindEntry(r) < 0) return false;
+      return true;
+    }
+    // Ranges [lo_i, hi_i): extend the covered prefix [lo, x) until it
+    // passes hi or no range continues it.
+    float x = lo;
+    for (int pass = 0; pass < count; ++pass) {
+      bool extended = false;
+      for (int i = 0; i < count; ++i)
+        if (keys[2 * i] <= x && keys[2 * i + 1] > x) {
+          x = keys[2 * i + 1];
+          extended = true;
+        }
+      if (x > hi) return true;
+      if (!extended) return false;
+    }
+    return x > hi;
+  }
+
   // Material TFs: whether entry i (hence materials[i]) is reachable in [lo, hi].
   MMRTM_CPU_GPU bool EntryInRange(int i, float lo, float hi) const {
     if (IsRangeTF(type)) return keys[2 * i] <= hi && keys[2 * i + 1] > lo;
@@ -135,6 +191,9 @@ struct TransferFunctionView {
   }
   MMRTM_CPU_GPU void Accumulate(const float* v, float* out) const {
     for (int c = 0; c < channels; ++c) out[c] = Max(out[c], v[c]);
+  }
+  MMRTM_CPU_GPU void AccumulateMin(const float* v, float* out) const {
+    for (int c = 0; c < channels; ++c) out[c] = Min(out[c], v[c]);
   }
 };
 
