@@ -37,7 +37,7 @@ class MajorantIterator {
     return MajorantIterator(grid, traversal, indexRay, tMin, tMax, scale);
   }
 
-  MMRTM_CPU_GPU bool Next(RayMajorantSegment* seg) {
+  MMRTM_INLINE MMRTM_CPU_GPU bool Next(RayMajorantSegment* seg) {  // forced: see GridMajorantIterator::Next
     if (isGrid_) return grid_.Next(&seg->tMin, &seg->tMax, &seg->sigma_maj, &seg->sigma_min);
     if (!pending_) return false;
     *seg = single_;

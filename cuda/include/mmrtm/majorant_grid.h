@@ -107,7 +107,9 @@ class GridMajorantIterator {
 
   // The next segment with a non-zero majorant, and a lower bound of the
   // extinction over it (0 without minorants); false at the end of the ray.
-  MMRTM_CPU_GPU bool Next(float* tMin, float* tMax, float* sigma_maj, float* sigma_min) {
+  // Forced inline: called for every segment, and GCC kept it out of line
+  // once it had four results (8 % more instructions on the chest CT).
+  MMRTM_INLINE MMRTM_CPU_GPU bool Next(float* tMin, float* tMax, float* sigma_maj, float* sigma_min) {
     while (t_ < tEnd_) {
       const float maj = grid_->majorants[node_];
       if (maj <= 0.f) {
