@@ -112,7 +112,8 @@ json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t 
   const double voxels = (double)dims[0] * dims[1] * dims[2];
   const size_t held = f.voxels + f.tables + f.majorants + f.minorants + summaries;
   return {{"input_voxel_bytes", inputVoxelBytes}, {"proxy_voxel_bytes", f.voxels}, {"tf_table_bytes", f.tables},
-          {"majorant_bytes", f.majorants}, {"minorant_bytes", f.minorants}, {"summary_bytes", summaries}, {"environment_bytes", f.environment},
+          {"majorant_bytes", f.majorants}, {"minorant_bytes", f.minorants}, {"summary_bytes", summaries},
+          {"environment_bytes", f.environment},
           {"grid_leaves", scene.Grid() ? scene.Grid()->LeafCount() : 0},
           {"distinct_leaf_summaries", scene.Grid() ? scene.Grid()->Summaries().Count() : 0},
           {"voxels", voxels}, {"bytes_per_voxel", held / voxels},

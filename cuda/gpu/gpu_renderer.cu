@@ -213,7 +213,8 @@ void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
 
 void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, bool summariesChanged) {
   Impl& m = *impl_;
-  if (!m.hasScene || !m.majorants || !m.minorants) throw CudaError("GpuRenderer::Refit: the uploaded scene has no majorant grid");
+  if (!m.hasScene || !m.majorants || !m.minorants)
+    throw CudaError("GpuRenderer::Refit: the uploaded scene has no majorant grid");
   if ((size_t)grid.NodeCount() != m.majorantCount)
     throw CudaError("GpuRenderer::Refit: the grid does not match the uploaded scene");
   RefitInputs in;

@@ -107,8 +107,6 @@ class MajorantGrid {
   size_t SummaryBytes() const { return summaries_.Bytes() + leafSummaryIds_.capacity() * sizeof(uint32_t); }
   int ProxyCount() const { return proxyCount_; }
   const MajorantGridView& View() const { return view_; }
-  // Each node's lower bound of sigma_t (DecodeMinorant of its byte).
-  float Minorant(int64_t node) const { return DecodeMinorant(majorants_[(size_t)node], minorants_[(size_t)node]); }
   int LeafLevel() const { return view_.leafLevel; }
   int64_t LeafCount() const;
   int64_t NodeCount() const { return (int64_t)majorants_.size(); }

@@ -128,7 +128,7 @@ MMRTM_CPU_GPU inline float SummaryMinorant(const Classifier& c, const RefitInput
   uint64_t candidates = ~0ull;
   if (!c.additive) {
     bool covered = c.defaultMaterial != kNoMaterial;
-    candidates = covered ? 1ull << c.defaultMaterial : 0;
+    candidates = covered ? 1ull << (c.defaultMaterial & 63) : 0;  // (unread without materialMasks)
     for (int s = 0; s < c.selectorCount; ++s) {
       const int t = c.selectors[s];
       const uint64_t* words = in.summaries[c.tfs[t].proxy] + summary * kSummaryWords;
