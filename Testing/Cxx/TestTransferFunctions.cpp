@@ -44,6 +44,18 @@ SceneView BuildWith(Scene& s, std::vector<TransferFunctionDesc> tfs) {
   return s.Build();
 }
 
+// A scene with materials "a" (the default) and "b", for material TFs.
+Scene SceneWithMaterialsAB() {
+  Scene s;
+  for (const char* n : {"a", "b"}) {
+    MaterialDesc m;
+    m.name = n;
+    s.materials.push_back(m);
+  }
+  s.defaultMaterial = 0;
+  return s;
+}
+
 float Eval1(const TransferFunctionView& tf, float x) {
   float v[3];
   tf.Evaluate(x, v);
@@ -140,13 +152,7 @@ TEST(TransferFunction, CDPTFWideKeysUseBinarySearch) {
 }
 
 TEST(TransferFunction, MaterialTFsPickMaterials) {
-  Scene s;
-  for (const char* n : {"a", "b"}) {
-    MaterialDesc m;
-    m.name = n;
-    s.materials.push_back(m);
-  }
-  s.defaultMaterial = 0;
+  Scene s = SceneWithMaterialsAB();
   SceneView v = BuildWith(s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}),
                               MaterialTF(TFType::MDPTF, 0, {2, 7}, {0, 1})});
   const TransferFunctionView& mp = v.classifier.tfs[0];
@@ -220,13 +226,7 @@ TEST(TransferFunction, MinOverRangeBoundsEveryValueFromBelow) {
 }
 
 TEST(TransferFunction, CoversRangeSaysWhetherEveryValueHasAnEntry) {
-  Scene s;
-  for (const char* n : {"a", "b"}) {
-    MaterialDesc m;
-    m.name = n;
-    s.materials.push_back(m);
-  }
-  s.defaultMaterial = 0;
+  Scene s = SceneWithMaterialsAB();
   SceneView v = BuildWith(s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}),
                               MaterialTF(TFType::MPCTF, 0, {4, 10, 0, 6}, {0, 1}),
                               MaterialTF(TFType::MDPTF, 0, {2, 3, 4, 7}, {0, 1, 0, 1}),

@@ -72,6 +72,34 @@ MMRTM_CPU_GPU inline float MaxOverBins(const RefitInputs& in, int t, const uint6
   return mx;
 }
 
+// The minimum of coefficient TF t's binMin over the set bins of a summary.
+MMRTM_CPU_GPU inline float MinOverBins(const RefitInputs& in, int t, const uint64_t* words) {
+  float mn = kInfinity;
+  if (in.byteMin) {
+    const float* table = in.byteMin + (size_t)t * kSummaryBytes * 256;
+    for (int w = 0; w < kSummaryWords; ++w)
+      for (uint64_t bits = words[w], byte = (uint64_t)w * 8; bits; bits >>= 8, ++byte)
+        if (bits & 0xff) mn = Min(mn, table[(byte << 8) | (bits & 0xff)]);
+  } else {
+    ForEachBin(words, [&](int bin) { mn = Min(mn, in.binMin[t * kSummaryBins + bin]); });
+  }
+  return mn < kInfinity ? mn : 0.f;
+}
+
+// Material m's base density times each of its density TFs' maximum
+// (`Lower`: minimum) over the bins of summary `summary`.
+template <bool Lower>
+MMRTM_CPU_GPU inline float MaterialDensityBound(const Classifier& c, const RefitInputs& in, int64_t summary, int m) {
+  const MaterialView& mat = c.materials[m];
+  float d = mat.base[0];
+  for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
+    const int t = c.bindings[mat.bindingBegin + b].tf;
+    const uint64_t* words = in.summaries[c.tfs[t].proxy] + summary * kSummaryWords;
+    d *= Lower ? MinOverBins(in, t, words) : MaxOverBins(in, t, words);
+  }
+  return d;
+}
+
 // The extinction bound of the leaves with summary `summary`: over the
 // materials that can occur in them (the default, and whatever a material TF
 // can pick from the summary's bins), the product of each density TF's
@@ -88,29 +116,10 @@ MMRTM_CPU_GPU inline float SummaryMajorant(const Classifier& c, const RefitInput
   float majorant = 0.f;
   for (int m = 0; m < c.materialCount; ++m) {
     if (in.materialMasks && !(candidates & (1ull << m))) continue;
-    const MaterialView& mat = c.materials[m];
-    float d = mat.base[0];
-    for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
-      const int t = c.bindings[mat.bindingBegin + b].tf;
-      d *= MaxOverBins(in, t, in.summaries[c.tfs[t].proxy] + summary * kSummaryWords);
-    }
+    const float d = MaterialDensityBound<false>(c, in, summary, m);
     majorant = c.additive ? majorant + d : Max(majorant, d);  // a mixture's extinctions add up
   }
   return Min(majorant, c.maxExtinction);  // as Classify clamps sigma_t
-}
-
-// The minimum of coefficient TF t's binMin over the set bins of a summary.
-MMRTM_CPU_GPU inline float MinOverBins(const RefitInputs& in, int t, const uint64_t* words) {
-  float mn = kInfinity;
-  if (in.byteMin) {
-    const float* table = in.byteMin + (size_t)t * kSummaryBytes * 256;
-    for (int w = 0; w < kSummaryWords; ++w)
-      for (uint64_t bits = words[w], byte = (uint64_t)w * 8; bits; bits >>= 8, ++byte)
-        if (bits & 0xff) mn = Min(mn, table[(byte << 8) | (bits & 0xff)]);
-  } else {
-    ForEachBin(words, [&](int bin) { mn = Min(mn, in.binMin[t * kSummaryBins + bin]); });
-  }
-  return mn < kInfinity ? mn : 0.f;
 }
 
 // A lower bound of the extinction in the leaves with summary `summary`
@@ -142,12 +151,7 @@ MMRTM_CPU_GPU inline float SummaryMinorant(const Classifier& c, const RefitInput
   float minorant = c.additive ? 0.f : kInfinity;
   for (int m = 0; m < c.materialCount; ++m) {
     if (in.materialMasks && !(candidates & (1ull << m))) continue;
-    const MaterialView& mat = c.materials[m];
-    float d = mat.base[0];
-    for (int b = 0; b < mat.densityBindingCount && d > 0.f; ++b) {
-      const int t = c.bindings[mat.bindingBegin + b].tf;
-      d *= MinOverBins(in, t, in.summaries[c.tfs[t].proxy] + summary * kSummaryWords);
-    }
+    const float d = MaterialDensityBound<true>(c, in, summary, m);
     minorant = c.additive ? minorant + d : Min(minorant, d);
   }
   return minorant < kInfinity ? Min(Max(minorant, 0.f), c.maxExtinction) : 0.f;
