@@ -134,7 +134,13 @@ std::string CheckDicomElementLengths(const std::string& file) {
     if (!readAt(pos, 8)) return "";
     if (inMeta && U16(b, false) != 0x0002) {
       inMeta = false;
-      if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: left to GDCM
+      // A deflated dataset's element lengths are inside the zlib stream,
+      // where this walk cannot see them: GDCM inflated one and allocated
+      // the 1.5 GB it stated (a fuzz finding). Refused until the walk
+      // inflates it first; no CT or MR series here uses it.
+      if (transferSyntax == "1.2.840.10008.1.2.1.99")
+        return "the dataset is deflate compressed (transfer syntax 1.2.840.10008.1.2.1.99), which this reader "
+               "does not support";
       if (!transferSyntax.empty()) {
         syntax.explicitVr = transferSyntax != "1.2.840.10008.1.2";
         syntax.bigEndian = transferSyntax == "1.2.840.10008.1.2.2";
