@@ -1,14 +1,17 @@
 // Failure cases (Documentation/accuracy.md, "Where methods fail"): each test
 // shows the failure of a baseline where there is one, and that the default
 // (delta and ratio tracking on the conservative octree) survives it.
-// Tolerances are kSigmas standard errors of each estimator, from the
-// estimator's own variance; the fixed seeds make every run identical.
+// Tolerances are test::ExpectUnbiased's (ExpectAgreement.h: 4.5 standard
+// errors of each estimator, from its own variance; it prints each check's
+// power); the fixed seeds make every run identical.
 // A volume of one voxel and a 1 x 1 x 1000 volume are refused with a clear
 // message: test_mmrtm_render_cli.py (test_degenerate_volumes).
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
 
+#include "ExpectAgreement.h"
 #include "FailureCaseScenes.h"
 #include "cpu_renderer.h"
 #include "film.h"
@@ -20,15 +23,13 @@ using failure::Estimate;
 using failure::Measure;  // 100000 trials unless told
 using failure::Method;
 
-constexpr double kSigmas = 4.0;
-
 // --- A narrow TF peak -------------------------------------------------------
 
 TEST(NarrowTFPeak, DeltaAndRatioTrackingOnTheOctreeAreExact) {
   for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
     failure::Case c = failure::NarrowPeak(0.1f, 8.f, MajorantKind::Octree, SummaryMode::CellRanges);
     Estimate e = Measure(c, m);
-    EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError) << "method " << (int)m;
+    test::ExpectUnbiased(e.mean, e.standardError, c.exact, "narrow peak, method " + std::to_string((int)m));
     EXPECT_EQ(e.violations, 0u);
   }
 }
@@ -61,8 +62,8 @@ TEST(SparseDenseStructure, GlobalMajorantIsSlowAndTheOctreeIsNot) {
   failure::Case octree = failure::SparseBlock(128, 1.f, MajorantKind::Octree);
   Estimate g = Measure(global, Method::RatioTracking), o = Measure(octree, Method::RatioTracking);
   // Both are exact...
-  EXPECT_NEAR(g.mean, global.exact, kSigmas * g.standardError);
-  EXPECT_NEAR(o.mean, octree.exact, kSigmas * o.standardError);
+  test::ExpectUnbiased(g.mean, g.standardError, global.exact, "sparse block, global majorant");
+  test::ExpectUnbiased(o.mean, o.standardError, octree.exact, "sparse block, octree");
   // ...but the global majorant (1 / mm) steps through the whole 128 mm.
   EXPECT_GT(g.lookupsPerRay, 50.0);  // fewer than 128: roulette ends some rays after the block
   EXPECT_LT(o.lookupsPerRay, g.lookupsPerRay / 10.0);
@@ -102,8 +103,10 @@ TEST(GrazingRays, AlongASliceOnANodeFace) {
       failure::Case c = failure::SliceSheet(z, 0.05f, kind);
       for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
         Estimate e = Measure(c, m);
-        EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError + 1e-6)
-            << "z " << z << " kind " << (int)kind << " method " << (int)m;
+        test::ExpectUnbiased(e.mean, e.standardError, c.exact,
+                             "sheet at z " + std::to_string(z) + ", kind " + std::to_string((int)kind) +
+                                 ", method " + std::to_string((int)m),
+                             1e-6);
         EXPECT_EQ(e.violations, 0u);
       }
     }
@@ -114,7 +117,7 @@ TEST(GrazingRays, TippedAcrossTheSheet) {
   for (float tilt : {1e-4f, 1e-2f}) {
     failure::Case c = failure::SliceSheet(16.f, 0.05f, MajorantKind::Octree, tilt);
     Estimate e = Measure(c, Method::RatioTracking);
-    EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError + 1e-4) << "tilt " << tilt;
+    test::ExpectUnbiased(e.mean, e.standardError, c.exact, "tilt " + std::to_string(tilt), 1e-4);
     EXPECT_EQ(e.violations, 0u);
   }
 }
@@ -149,7 +152,7 @@ TEST(DegenerateTF, AllOneIsAHomogeneousBox) {
     failure::Case c = failure::AllOneTF(kind);
     for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
       Estimate e = Measure(c, m);
-      EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError) << "kind " << (int)kind;
+      test::ExpectUnbiased(e.mean, e.standardError, c.exact, "all-one TF, kind " + std::to_string((int)kind));
       if (kind == MajorantKind::Octree && m == Method::RatioTracking)
         EXPECT_LT(e.lookupsPerRay, 0.1 * 16.0 * 1.5 + 1.0) << "a tight majorant: about sigma x length lookups";
     }
@@ -161,7 +164,8 @@ TEST(DegenerateTF, StepAtTheDataMaximum) {
     failure::Case c = failure::SaturatedBlock(0.4f, kind);
     for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
       Estimate e = Measure(c, m);
-      EXPECT_NEAR(e.mean, c.exact, kSigmas * e.standardError + 1e-3) << "kind " << (int)kind;
+      test::ExpectUnbiased(e.mean, e.standardError, c.exact, "step at the maximum, kind " + std::to_string((int)kind),
+                           1e-3);
       EXPECT_EQ(e.violations, 0u);
     }
   }
