@@ -1,6 +1,6 @@
-// The BSDF, the phase function and the environment light: energy
-// conservation, and sampling that matches the pdf (chi-square test over a
-// grid of equal-area bins on the sphere).
+// The phase function and the environment light: sampling that matches the
+// pdf (chi-square test over a grid of equal-area bins on the sphere). The
+// BSDF's tests, and HG's mean cosine, are in TestBSDF.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "environment_map.h"
-#include "mmrtm/bsdf.h"
 #include "mmrtm/lights.h"
 #include "mmrtm/phase.h"
 #include "mmrtm/rng.h"
@@ -130,68 +129,6 @@ TEST(Phase, HenyeyGreensteinIntegratesToOneAndSamplesItsPdf) {
     EXPECT_NEAR(r.pdfIntegral, 1.0, g > 0.5f ? 1e-2 : 2e-3) << "g " << g;
     EXPECT_GT(r.pValue, kAlpha) << "g " << g;
   }
-}
-
-TEST(BSDF, SamplingMatchesPdf) {
-  // The normal is +z so that the horizon, where the pdf drops to zero, is a
-  // bin edge: a tilted horizon cuts bins that the midpoint rule integrates badly.
-  const Vec3 normal{0.f, 0.f, 1.f};
-  for (float roughness : {0.35f, 0.7f, 1.f})
-    for (float metallic : {0.f, 1.f})
-      for (float cosO : {0.9f, 0.4f}) {
-        const float sinO = std::sqrt(1 - cosO * cosO);
-        const Vec3 wo{0.6f * sinO, 0.8f * sinO, cosO};
-        SurfaceBSDF bsdf = SurfaceBSDF::Make(normal, wo, RGB(0.8f, 0.6f, 0.4f), roughness, metallic);
-        ChiSquareResult r = ChiSquare(
-            [&](PCG32& rng, Vec3* w) {
-              float a = rng.Uniform(), b = rng.Uniform(), c = rng.Uniform();
-              BSDFSample s = bsdf.Sample(wo, a, b, c);
-              *w = s.wi;
-              return s.pdf > 0.f;
-            },
-            [&](Vec3 w) { return bsdf.Pdf(wo, w); }, 400000);
-        EXPECT_GT(r.pValue, kAlpha) << "roughness " << roughness << " metallic " << metallic << " cos " << cosO;
-        EXPECT_LE(r.pdfIntegral, 1.0 + 1e-2);
-      }
-}
-
-// Directional albedo: the integral of f cos over the hemisphere, estimated by
-// importance sampling; with a white base colour it must not exceed 1.
-TEST(BSDF, ConservesEnergy) {
-  const Vec3 normal{0.f, 0.f, 1.f};
-  const int n = 200000;
-  for (float roughness : {0.1f, 0.4f, 1.f})
-    for (float metallic : {0.f, 0.5f, 1.f})
-      for (float cosO : {1.f, 0.5f, 0.1f}) {
-        Vec3 wo{std::sqrt(1 - cosO * cosO), 0.f, cosO};
-        SurfaceBSDF bsdf = SurfaceBSDF::Make(normal, wo, RGB(1.f), roughness, metallic);
-        PCG32 rng(3, 5);
-        double sum = 0, sum2 = 0;
-        for (int i = 0; i < n; ++i) {
-          float a = rng.Uniform(), b = rng.Uniform(), c = rng.Uniform();
-          BSDFSample s = bsdf.Sample(wo, a, b, c);
-          double v = s.pdf > 0 ? s.f_cos.g / s.pdf : 0.0;
-          sum += v;
-          sum2 += v * v;
-        }
-        double mean = sum / n, sigma = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
-        EXPECT_LE(mean, 1.0 + 3 * sigma) << "roughness " << roughness << " metallic " << metallic << " cos " << cosO;
-        // Not black: even a rough metal at grazing angles (single scattering
-        // loses the most there) keeps more than a fifth.
-        EXPECT_GT(mean, 0.2) << "roughness " << roughness << " metallic " << metallic << " cos " << cosO;
-      }
-}
-
-TEST(BSDF, BackSideLightIsAbsorbed) {
-  const Vec3 normal{0.f, 0.f, 1.f};
-  const Vec3 wo = Normalize(Vec3{0.3f, 0.f, 1.f});
-  SurfaceBSDF bsdf = SurfaceBSDF::Make(normal, wo, RGB(1.f), 0.5f, 0.f);
-  EXPECT_TRUE(bsdf.Eval(wo, Normalize(Vec3{0.2f, 0.1f, -1.f})).IsBlack());
-  EXPECT_EQ(bsdf.Pdf(wo, Normalize(Vec3{0.2f, 0.1f, -1.f})), 0.f);
-  EXPECT_FALSE(bsdf.Eval(wo, Normalize(Vec3{0.2f, 0.1f, 1.f})).IsBlack());
-  // Seen from the other side, the normal turns toward the viewer.
-  SurfaceBSDF flipped = SurfaceBSDF::Make(normal, -wo, RGB(1.f), 0.5f, 0.f);
-  EXPECT_FALSE(flipped.Eval(-wo, Normalize(Vec3{0.2f, 0.1f, -1.f})).IsBlack());
 }
 
 TEST(EnvironmentLight, SamplingMatchesPdf) {
