@@ -38,6 +38,7 @@
 #include "label_alignment.h"
 #include "mmrtmImageDataConversion.h"
 #include "mmrtmVtkSceneTranslation.h"
+#include "mmrtm/planted_defect.h"
 #include "render_backend.h"
 #include "scene.h"
 #include "scene_json.h"
@@ -129,12 +130,14 @@ vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
     if (vtkPiecewiseFunction* f = p->GetLabelGradientOpacity(label))
       t = std::max(t, f->GetMTime());
     if (vtkColorTransferFunction* f = p->GetLabelColor(label))
-      t = std::max(t, f->GetMTime());
+      t = std::max(t, mmrtm::Planted(mmrtm::Defect::MapperColorRefit) ? 0 : f->GetMTime());
   }
   for (int c = 0; c < 4; ++c)  // independent components have functions of their own
   {
     t = std::max(t, p->GetScalarOpacity(c)->GetMTime());
     t = std::max(t, p->GetGradientOpacity(c)->GetMTime());
+    if (mmrtm::Planted(mmrtm::Defect::MapperColorRefit))
+      continue;
     if (p->GetColorChannels(c) == 3)
       t = std::max(t, p->GetRGBTransferFunction(c)->GetMTime());
     else
@@ -142,6 +145,8 @@ vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
   }
   // Last: asking for a component's function the first time creates a
   // default one and modifies the property.
+  if (mmrtm::Planted(mmrtm::Defect::MapperColorRefit))
+    return std::max(t, p->vtkObject::GetMTime());  // vtkVolumeProperty's own counts the colour functions
   return std::max(t, p->GetMTime());
 }
 

@@ -1,5 +1,7 @@
 #include "film.h"
 
+#include "mmrtm/planted_defect.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -52,7 +54,7 @@ RGB Film::VarianceOfMean(int x, int y) const {
   const uint32_t n = PixelSamples(x, y);
   if (n < 2) return RGB(0.f);
   const float* s = &m2_[3 * ((size_t)y * width_ + x)];
-  const float norm = 1.f / ((float)n * (float)(n - 1));
+  const float norm = 1.f / ((float)n * (float)(n - 1)) * (Planted(Defect::FilmVariance) ? 0.5f : 1.f);
   return RGB(s[0] * norm, s[1] * norm, s[2] * norm);
 }
 

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "mmrtm/defs.h"
+#include "mmrtm/planted_defect.h"
 #include "mmrtm/sampling.h"
 #include "mmrtm/vecmath.h"
 
@@ -90,7 +91,8 @@ struct SurfaceBSDF {
   // (checked by the energy test for roughness 0.1..1 and all angles).
   MMRTM_CPU_GPU RGB DiffuseWeight(float cosO) const {
     RGB f0 = SpecularF0();
-    return baseColor * ((1.f - metallic) * (1.f - Luminance(f0)) * (1.f - Luminance(SchlickFresnel(f0, cosO))));
+    return baseColor * ((1.f - metallic) * (1.f - Luminance(f0)) * (1.f - Luminance(SchlickFresnel(f0, cosO))) *
+                        (Planted(Defect::DiffuseLobe) ? 0.95f : 1.f));
   }
   MMRTM_CPU_GPU float SpecularProbability(float cosO) const {
     float s = Luminance(SchlickFresnel(SpecularF0(), cosO));
@@ -104,7 +106,8 @@ struct SurfaceBSDF {
     if (wo.z <= 0.f || wi.z <= 0.f) return RGB(0.f);
     GGX ggx{alpha};
     Vec3 h = Normalize(wo + wi);
-    RGB spec = SchlickFresnel(SpecularF0(), Dot(wo, h)) * (ggx.D(h) * ggx.G(wo, wi) / (4.f * wo.z));
+    RGB spec = SchlickFresnel(SpecularF0(), Dot(wo, h)) *
+               (ggx.D(h) * ggx.G(wo, wi) / (4.f * wo.z) * (Planted(Defect::SpecularLobe) ? 0.95f : 1.f));
     return spec + DiffuseWeight(wo.z) * (kInvPi * wi.z);
   }
 

@@ -18,6 +18,7 @@
 
 #include "mmrtm/bsdf.h"
 #include "mmrtm/phase.h"
+#include "mmrtm/planted_defect.h"
 #include "mmrtm/sobol.h"
 #include "mmrtm/tracking.h"
 
@@ -119,7 +120,7 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
       }
     }
     HGPhaseFunction phase{k.g};
-    if (!surface) beta *= k.albedo;
+    if (!surface) beta *= Planted(Defect::VolumeAlbedo) ? k.albedo * 0.97f : k.albedo;
 
     // Next-event estimation (IntegratorSettings::lightSampling).
     if (s.lightCount > 0) {
@@ -139,7 +140,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
         RGB f = surface ? bsdf.Eval(wo, ls.wi) : RGB(phase.p(wo, ls.wi));
         if (f.IsBlack()) return false;
         float lightPdf = lightSelectPdf * ls.pdf;
-        float w = ls.isDelta ? 1.f : PowerHeuristic(lightPdf, surface ? bsdf.Pdf(wo, ls.wi) : phase.Pdf(wo, ls.wi));
+        const float misLightPdf = Planted(Defect::LightWeights) ? ls.pdf : lightPdf;
+        float w = ls.isDelta ? 1.f : PowerHeuristic(misLightPdf, surface ? bsdf.Pdf(wo, ls.wi) : phase.Pdf(wo, ls.wi));
         *c = beta * f * ls.L * (w / lightPdf);
         return true;
       };

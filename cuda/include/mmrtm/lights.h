@@ -5,6 +5,7 @@
 #pragma once
 
 #include "mmrtm/defs.h"
+#include "mmrtm/planted_defect.h"
 #include "mmrtm/sampling.h"
 #include "mmrtm/vecmath.h"
 
@@ -34,6 +35,7 @@ struct EnvironmentView {
   }
   // Solid-angle pdf from the (u, v) pdf, at a polar angle of sine sinTheta.
   MMRTM_CPU_GPU static float SolidAnglePdf(float pdfUV, float sinTheta) {
+    if (Planted(Defect::EnvironmentPdf)) pdfUV *= 1.05f;
     return sinTheta > 0.f ? pdfUV / (2.f * kPi * kPi * sinTheta) : 0.f;
   }
 

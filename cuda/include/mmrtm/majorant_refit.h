@@ -16,6 +16,7 @@
 
 #include "mmrtm/classifier.h"
 #include "mmrtm/majorant_grid.h"
+#include "mmrtm/planted_defect.h"
 
 namespace mmrtm {
 
@@ -119,6 +120,7 @@ MMRTM_CPU_GPU inline float SummaryMajorant(const Classifier& c, const RefitInput
     const float d = MaterialDensityBound<false>(c, in, summary, m);
     majorant = c.additive ? majorant + d : Max(majorant, d);  // a mixture's extinctions add up
   }
+  if (Planted(Defect::MajorantLow)) majorant *= 0.98f;
   return Min(majorant, c.maxExtinction);  // as Classify clamps sigma_t
 }
 
@@ -154,6 +156,7 @@ MMRTM_CPU_GPU inline float SummaryMinorant(const Classifier& c, const RefitInput
     const float d = MaterialDensityBound<true>(c, in, summary, m);
     minorant = c.additive ? minorant + d : Min(minorant, d);
   }
+  if (Planted(Defect::MinorantHigh)) minorant *= 1.02f;
   return minorant < kInfinity ? Min(Max(minorant, 0.f), c.maxExtinction) : 0.f;
 }
 

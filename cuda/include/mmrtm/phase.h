@@ -6,6 +6,7 @@
 #pragma once
 
 #include "mmrtm/defs.h"
+#include "mmrtm/planted_defect.h"
 #include "mmrtm/vecmath.h"
 
 namespace mmrtm {
@@ -18,6 +19,7 @@ struct PhaseSample {
 
 MMRTM_CPU_GPU inline float HenyeyGreenstein(float cosTheta, float g) {
   // cosTheta between the travel directions -wo and wi.
+  if (Planted(Defect::PhaseSign)) g = -g;
   float denom = 1.f + g * g - 2.f * g * cosTheta;
   return kInv4Pi * (1.f - g * g) / (denom * SafeSqrt(denom));
 }
@@ -33,8 +35,9 @@ struct HGPhaseFunction {
     if (fabsf(g) < 1e-3f) {
       cosTheta = 1.f - 2.f * u0;
     } else {
-      float s = (1.f - g * g) / (1.f - g + 2.f * g * u0);
-      cosTheta = Clamp((1.f + g * g - s * s) / (2.f * g), -1.f, 1.f);
+      const float gs = Planted(Defect::PhaseSign) ? -g : g;
+      float s = (1.f - gs * gs) / (1.f - gs + 2.f * gs * u0);
+      cosTheta = Clamp((1.f + gs * gs - s * s) / (2.f * gs), -1.f, 1.f);
     }
     float sinTheta = SafeSqrt(1.f - cosTheta * cosTheta);
     float phi = 2.f * kPi * u1;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "mmrtm/counters.h"
+#include "mmrtm/planted_defect.h"
 #include "mmrtm/rng.h"
 #include "mmrtm/scene_view.h"
 
@@ -75,6 +76,7 @@ MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ra
   while (it.Next(&seg)) {
     ++ctr.majorantSegments;
     if constexpr (Residual) {
+      if (Planted(Defect::ShadowLastSegment) && seg.tMax >= t1) return;
       if (!segment(seg)) return;
       seg.sigma_maj -= seg.sigma_min;
     }

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "mmrtm/defs.h"
+#include "mmrtm/planted_defect.h"
 
 namespace mmrtm {
 
@@ -107,6 +108,10 @@ struct TransferFunctionView {
 
   // Material TFs: the material at x, or kNoMaterial.
   MMRTM_CPU_GPU int EvaluateMaterial(float x) const {
+    if (Planted(Defect::LabelSwap) && type == TFType::MDPTF) {
+      const float r = floorf(x + 0.5f);
+      x = r == 1.f ? 2.f : r == 2.f ? 1.f : x;
+    }
     int i = FindEntry(x);
     return i < 0 ? kNoMaterial : materials[i];
   }
