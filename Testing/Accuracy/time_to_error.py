@@ -1,20 +1,26 @@
 #!/usr/bin/env python3
 """Time to the error that 64 spp gave before issue 15, on the five reference
-scenes: the renderer as it was (one light chosen uniformly, uniform
-sampling, independent random numbers), with next-event estimation by
-resampling, with the Sobol' sampler on top (both the default now), and with
-adaptive sampling on top of that.
+scenes, measured: the renderer as it was (one light chosen uniformly,
+uniform sampling, independent random numbers), with next-event estimation
+by resampling, with the Sobol' sampler on top (both the default now), and
+with adaptive sampling on top of that.
 
-    Testing/Accuracy/time_to_error.py [--spp 64] [--repeats 2] [--only NAME ...]
-        [--issue-binary OLD/bin/mmrtm-render]
+    Testing/Accuracy/time_to_error.py [--spp 64] [--ladder 4,8,16,32,64,128]
+        [--repeats 2] [--only NAME ...] [--issue-binary OLD/bin/mmrtm-render]
 
-Needs the references of make_references.py (256 x 256). Each method renders
-`--spp` samples per pixel (a mean of that many with adaptive sampling); the
-methods take turns, `--repeats` times, so that the machine's noise falls on
-all of them alike, and the median render time counts. The error is the
-relative RMSE against the reference (its own variance subtracted). Every
-estimator here is unbiased, so its error falls as 1 / sqrt(time): the time
-a method needs to reach the first method's error is t (e / e_before)^2.
+Needs the references of make_references.py (256 x 256). The target is the
+first method's relative RMSE (against the reference, its own variance
+subtracted) at `--spp` samples per pixel. Every method renders a ladder of
+sample counts (`--ladder`; a mean count with adaptive sampling), the
+methods taking turns `--repeats` times so that the machine's noise falls on
+all of them alike (the median render time counts). A method's time to the
+target is read off its measured curve: between the two rungs whose errors
+bracket the target, by interpolating log error against log time; "<=" marks
+a target met already at the lowest rung, ">" one not met at the highest.
+Nothing is extrapolated: Sobol' samples and adaptive sampling need not
+follow 1 / sqrt(time), and the table gives each method's measured slope of
+log error against log time (-0.5 for plain Monte Carlo) beside the
+extrapolation from its 64-spp error that the table used to print.
 Prints a Markdown table and writes MMRTM_REFERENCE_DIR/time_to_error.json.
 
 With --issue-binary, a first method renders with that mmrtm-render: a build
@@ -31,6 +37,7 @@ The speed-ups are then against that first method.
 
 import argparse
 import json
+import math
 import statistics
 
 import mmrtm_accuracy as acc
@@ -45,42 +52,82 @@ METHODS = [
 ]
 
 
+def time_to_target(points, target):
+    """(seconds, marker) at which the measured curve [(seconds, error), ...],
+    in ladder order, first reaches `target`: interpolated in log-log between
+    the bracketing rungs; marker "<=" or ">" where the ladder does not
+    bracket it."""
+    for k, (t, e) in enumerate(points):
+        if e <= target:
+            if k == 0:
+                return t, "<="
+            t0, e0 = points[k - 1]
+            if e == e0:
+                return t, ""
+            slope = (math.log(t) - math.log(t0)) / (math.log(e) - math.log(e0))
+            return math.exp(math.log(t0) + (math.log(target) - math.log(e0)) * slope), ""
+    return points[-1][0], ">"
+
+
+def fitted_slope(points):
+    """Least-squares slope of log error against log time."""
+    xs = [math.log(t) for t, _ in points]
+    ys = [math.log(e) for _, e in points]
+    mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+    sxx = sum((x - mx) ** 2 for x in xs)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else float("nan")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--spp", type=int, default=64, help="the first method's samples per pixel: the target")
+    parser.add_argument("--ladder", default="4,8,16,32,64,128", help="sample counts every method renders")
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     parser.add_argument("--issue-binary", help="mmrtm-render built at the commit issue 15 was filed on")
     args = parser.parse_args()
+    ladder = sorted({int(v) for v in args.ladder.split(",")} | {args.spp})
     methods = [(label, options, None) for label, options in METHODS]
     if args.issue_binary:
         methods.insert(0, ("when issue 15 was filed (c669328)", [], args.issue_binary))
     results = {}
-    lines = ["| scene | method | render s | rel. RMSE | time to the first row's error | speed-up |", "|---|---|---|---|---|---|"]
+    lines = ["| scene | method | target error (the first row's at --spp) | time to it (measured) | "
+             "speed-up | extrapolated from 64 spp | slope of log error / log time |",
+             "|---|---|---|---|---|---|---|"]
     for name in args.only or list(acc.SCENES):
         ref = acc.load_reference(name)
         if ref is None:
             raise SystemExit(f"no reference for {name} in {acc.REFERENCE_DIR}: run make_references.py first")
         ref_mean, ref_var, _ = ref
-        times = {label: [] for label, _, _ in methods}
+        times = {(label, spp): [] for label, _, _ in methods for spp in ladder}
         errors = {}
         # Alternating methods: the machine's noise falls on all of them alike.
         for _ in range(args.repeats):
-            for label, options, binary in methods:
-                r = acc.render(acc.SCENES[name]["args"], ref_mean.shape[1], ref_mean.shape[0], args.spp, seed=SEED,
-                               extra=["--shadow-scale", "1", *options], binary=binary)
-                times[label].append(r.seconds)
-                errors[label] = acc.relative_rmse(r.mean, ref_mean, ref_var)  # the same image every repeat
-        before = methods[0][0]
-        t0, e0 = statistics.median(times[before]), errors[before]
-        results[name] = {}
+            for spp in ladder:
+                for label, options, binary in methods:
+                    r = acc.render(acc.SCENES[name]["args"], ref_mean.shape[1], ref_mean.shape[0], spp, seed=SEED,
+                                   extra=["--shadow-scale", "1", *options], binary=binary)
+                    times[(label, spp)].append(r.seconds)
+                    errors[(label, spp)] = acc.relative_rmse(r.mean, ref_mean, ref_var)  # the same every repeat
+        first = methods[0][0]
+        target = errors[(first, args.spp)]
+        t_first = statistics.median(times[(first, args.spp)])
+        results[name] = {"target_rel_rmse": target, "first_method_seconds": t_first, "methods": {}}
         for label, _, _ in methods:
-            t, e = statistics.median(times[label]), errors[label]
-            reach = t * (e / e0) ** 2
-            results[name][label] = {"seconds": t, "all_seconds": times[label], "rel_rmse": e,
-                                    "time_to_before_error": reach, "speedup": t0 / reach}
-            lines.append(f"| {acc.SCENES[name]['title']} | {label} | {t:.2f} | {e:.4f} | {reach:.2f} s | "
-                         f"{t0 / reach:.2f} |")
+            points = [(statistics.median(times[(label, spp)]), errors[(label, spp)]) for spp in ladder]
+            reach, marker = time_to_target(points, target)
+            t64, e64 = statistics.median(times[(label, args.spp)]), errors[(label, args.spp)]
+            extrapolated = t64 * (e64 / target) ** 2
+            slope = fitted_slope(points)
+            results[name]["methods"][label] = {
+                "ladder": [{"spp": spp, "seconds": t, "all_seconds": times[(label, spp)], "rel_rmse": e}
+                           for spp, (t, e) in zip(ladder, points)],
+                "time_to_target": reach, "bound": marker, "speedup": t_first / reach,
+                "extrapolated_time": extrapolated, "extrapolated_speedup": t_first / extrapolated,
+                "slope": slope}
+            speedup = {"<=": ">=", ">": "<", "": ""}[marker] + f"{t_first / reach:.2f}"
+            lines.append(f"| {acc.SCENES[name]['title']} | {label} | {target:.4f} | {marker}{reach:.2f} s | "
+                         f"{speedup} | {t_first / extrapolated:.2f} | {slope:.2f} |")
             print(lines[-1], flush=True)
     (acc.REFERENCE_DIR / "time_to_error.json").write_text(json.dumps(results, indent=1))
     print("\n".join(lines))
