@@ -144,9 +144,13 @@ class TestMmrtmViewer : public QObject {
     table->setLabel(liver, entry);
     QVERIFY(RefineTo(v.window, 8));
     const QImage before = View(v.window);
+    vtkMultiMaterialVolumeMapper* m = v.window.scene().Mapper();
+    const int restarts = m->GetNumberOfRestarts();
     entry.visible = false;
     table->setLabel(liver, entry);
-    QTest::qWait(50);
+    // The edit reaches the mapper at its next render, which may wait for a
+    // pass in flight: until it restarts, the count of 8 is the old image's.
+    QVERIFY2(QTest::qWaitFor([&] { return m->GetNumberOfRestarts() > restarts; }, 120000), "hiding restarts");
     QVERIFY(RefineTo(v.window, 8));
     const QImage after = View(v.window);
     // The liver's pixels (blue before) change; the others, far from it, do not.
