@@ -3,7 +3,9 @@
 // For each dataset and accelerator (none, macrocell, octree at two leaf
 // levels, octree-voxelmax, and the voxel-exact ideal: one majorant per voxel
 // cell) it measures
-//   - the summary build after a data load, and the refit after a TF change;
+//   - the summary build after a data load, the refit after a TF change,
+//     and a Build with nothing changed (what every render after a camera
+//     move pays: no refit, so the same with and without an accelerator);
 //   - the time to locate the nearest and the farthest non-empty point along
 //     the camera rays (walking the majorant segments);
 //   - global illumination at N spp (default 10) at W x W (default 512);
@@ -94,7 +96,7 @@ void ShiftDensityTFs(Scene& scene, float direction) {
 
 struct Result {
   std::string dataset, config;
-  double build = 0, refit = 0, locate = 0, render = 0;
+  double build = 0, refit = 0, unchanged = 0, locate = 0, render = 0;
   double lookupsPerReal = 0, meanZ2 = 0;
   int leafLevel = -1;
   int64_t nodes = 0;
@@ -181,8 +183,8 @@ int main(int argc, char** argv) {
   if (withIdeal) configs.push_back({"ideal (voxel-exact)", MajorantKind::Macrocell, SummaryMode::CellRanges, 0, true});
 
   std::vector<Result> results;
-  std::printf("%-20s %-20s %5s %9s %9s %9s %9s %8s %8s %7s\n", "dataset", "accelerator", "leaf", "build ms",
-              "refit ms", "locate ms", "GI s", "GI x", "look/real", "z^2");
+  std::printf("%-20s %-20s %5s %9s %9s %9s %9s %9s %8s %8s %7s\n", "dataset", "accelerator", "leaf", "build ms",
+              "refit ms", "same us", "locate ms", "GI s", "GI x", "look/real", "z^2");
   for (const Dataset& d : datasets) {
     HostVolume volume = LoadVolume(d.file, "scalars");
     if (d.resample > 0) volume = Resample(volume, d.resample);
@@ -233,6 +235,15 @@ int main(int argc, char** argv) {
         std::sort(refits.begin(), refits.end());
         r.refit = refits[refits.size() / 2];
       }
+      // A Build with nothing changed: the median of 5.
+      std::vector<double> unchanged;
+      for (int i = 0; i < 5; ++i) {
+        const auto start = Clock::now();
+        view = scene.Build();
+        unchanged.push_back(Seconds(start));
+      }
+      std::sort(unchanged.begin(), unchanged.end());
+      r.unchanged = unchanged[unchanged.size() / 2];
       float minSpacing = kInfinity;
       for (int a = 0; a < 3; ++a)
         minSpacing = std::min(minSpacing, Length(Vec3{scene.proxies[0].indexToWorld.m[0][a],
@@ -252,8 +263,8 @@ int main(int argc, char** argv) {
       }
       r.meanZ2 = MeanSquaredZScore(noneFilm, film);
       results.push_back(r);
-      std::printf("%-20s %-20s %5d %9.2f %9.2f %9.1f %9.2f %8.2f %8.2f %7.3f%s\n", d.name.c_str(), c.name.c_str(),
-                  r.leafLevel, r.build * 1e3, r.refit * 1e3, r.locate * 1e3, r.render, noneRender / r.render,
+      std::printf("%-20s %-20s %5d %9.2f %9.2f %9.2f %9.1f %9.2f %8.2f %8.2f %7.3f%s\n", d.name.c_str(),
+                  c.name.c_str(), r.leafLevel, r.build * 1e3, r.refit * 1e3, r.unchanged * 1e6, r.locate * 1e3, r.render, noneRender / r.render,
                   r.lookupsPerReal, r.meanZ2, r.violations ? "  (majorant violations!)" : "");
       std::fflush(stdout);
     }
@@ -263,6 +274,7 @@ int main(int argc, char** argv) {
   for (const Result& r : results)
     out.push_back({{"dataset", r.dataset}, {"accelerator", r.config}, {"leaf_level", r.leafLevel},
                    {"nodes", r.nodes}, {"build_seconds", r.build}, {"refit_seconds", r.refit},
+                   {"unchanged_build_seconds", r.unchanged},
                    {"locate_seconds", r.locate}, {"gi_seconds", r.render}, {"lookups_per_real_collision", r.lookupsPerReal},
                    {"mean_z2_vs_none", r.meanZ2}, {"majorant_violations", r.violations}});
   std::ofstream(jsonOut) << json({{"width", width}, {"spp", spp}, {"results", out}}).dump(2) << "\n";

@@ -557,8 +557,9 @@ json ViewerScene::Description() const {
 }
 
 void ViewerScene::Apply() {
-  const std::string text = Description().dump();
-  if (text != materials_->GetSceneJSON()) materials_->SetSceneJSON(text.c_str());
+  // The property keeps its modification time when the description is the
+  // one it holds: the mapper then neither refits nor restarts.
+  materials_->SetSceneJSON(Description().dump().c_str());
 }
 
 }  // namespace mmrtm::viewer

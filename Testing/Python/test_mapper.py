@@ -12,7 +12,7 @@ import sys
 import tempfile
 import unittest
 
-from vtkmodules.vtkCommonCore import vtkFloatArray
+from vtkmodules.vtkCommonCore import vtkCommand, vtkFloatArray
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction, vtkPlane, vtkPlaneCollection
 from vtkmodules.vtkImagingCore import vtkImageAppendComponents, vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
@@ -466,6 +466,51 @@ class MapperTest(unittest.TestCase):
         s.property.SetComponentWeight(1, 0.0)
         s.render()
         self.assertLess(abs(coverage(s.pixels()) - alone), 0.01)
+
+    def test_each_warning_once_for_its_own_cause(self):
+        """Each of the mapper's warnings is said once when its cause appears,
+        not on every render, and the others are still said after it. Catches
+        one flag shared by the warnings (after the first, the others were
+        never said) and a warning repeated on every render."""
+        s = Scene()
+        warnings = ErrorCatcher()
+        s.mapper.AddObserver(vtkCommand.WarningEvent, warnings)
+
+        def said(text):
+            return sum(1 for m in warnings.messages if text in m)
+
+        s.mapper.SetBlendModeToMaximumIntensity()
+        s.render()
+        s.render()
+        self.assertEqual(said("only composite blending"), 1, warnings.messages)
+        s.mapper.SetCroppingRegionPlanes(*s.mapper.GetBounds())
+        s.mapper.SetCroppingRegionFlagsToFence()
+        s.mapper.CroppingOn()
+        s.render()
+        s.render()
+        self.assertEqual(said("only the subvolume cropping region"), 1, warnings.messages)
+        # Five independent components: the CT five times.
+        five = vtkImageAppendComponents()
+        for _ in range(5):
+            five.AddInputConnection(s.reader.GetOutputPort())
+        s.mapper.SetInputConnection(five.GetOutputPort())
+        s.property.IndependentComponentsOn()
+        s.render()
+        s.render()
+        self.assertEqual(said("only the first 4 of 5 independent components"), 1, warnings.messages)
+        # A mask as well: its own warning; the components' cause still holds, not said again.
+        threshold, _ = s.add_bone_labels((1.0, 0.2, 0.2))
+        s.render()
+        s.render()
+        self.assertEqual(said("with independent components, the mask is not used"), 1, warnings.messages)
+        self.assertEqual(said("only the first 4 of 5 independent components"), 1, warnings.messages)
+        # A cause that goes away and comes back is said again.
+        s.mapper.SetBlendModeToComposite()
+        s.render()
+        s.mapper.SetBlendModeToMaximumIntensity()
+        s.render()
+        self.assertEqual(said("only composite blending"), 2, warnings.messages)
+        self.assertEqual(len(warnings.messages), 5, warnings.messages)
 
     def test_noise_target_stops_the_refinement(self):
         s = Scene()

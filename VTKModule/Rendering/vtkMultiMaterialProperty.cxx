@@ -86,6 +86,8 @@ bool ChangeDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, Ch
     vtkErrorWithObjectMacro(self, << e.what());
     return false;
   }
+  if (next == document)  // as vtkSetMacro: an unchanged value leaves the modification time
+    return true;
   document = std::move(next);
   self->Modified();
   return true;

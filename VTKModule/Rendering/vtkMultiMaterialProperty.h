@@ -19,6 +19,10 @@
  * MMRTM_DATA_DIR/presets when that environment variable is set, else the
  * installed presets (beside the library in the Python wheel, in
  * share/mmrtm/presets of an install tree), else the source tree's.
+ *
+ * As VTK's Set methods do, a setter that leaves the description as it was
+ * (the same JSON value) does not modify the property: a mapper rendering
+ * it goes on accumulating.
  */
 #ifndef vtkMultiMaterialProperty_h
 #define vtkMultiMaterialProperty_h

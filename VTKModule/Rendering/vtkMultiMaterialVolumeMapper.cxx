@@ -85,7 +85,20 @@ struct vtkMultiMaterialVolumeMapper::Internals
   vtkMTimeType LabelMaterialParametersBuilt = 0;
   std::vector<double> View;
   std::vector<float> Depth;  // the depth buffer under the volume at the last restart
-  bool HasScene = false, Warned = false;
+  bool HasScene = false;
+
+  // Whether each warning's cause held when it was last checked: a warning
+  // is said when its cause appears, and again only after the cause went
+  // away and came back (each its own flag: one shared flag silenced the
+  // others after the first).
+  std::map<std::string, bool> WarningCauses;
+  bool Warn(const std::string& warning, bool cause)
+  {
+    bool& held = this->WarningCauses[warning];
+    const bool say = cause && !held;
+    held = cause;
+    return say;
+  }
 
   // Asynchronous refinement: the pass in flight adds samples to Film on a
   // thread of its own while renders draw Shown (Film as of the last pass
@@ -104,6 +117,10 @@ struct vtkMultiMaterialVolumeMapper::Internals
     std::vector<double> View;     // compared as views are (SameView)
     std::vector<double> Exact;    // modification times, objects, depth, settings
   } PassStamp;
+
+  // The last exposure edit: the mapper's modification time before it (as
+  // TracingMTime gave it) and after.
+  vtkMTimeType ExposureEditBefore = 0, ExposureEditAfter = 0;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0;
   std::string LastExtinctionWarning;  // said once per change (vtkWarningMacro)
@@ -301,6 +318,28 @@ void vtkMultiMaterialVolumeMapper::ResetAccumulation()
     this->Internal->Film->Reset();
 }
 
+void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
+{
+  exposure = std::max(0.0, exposure);
+  if (exposure == this->Exposure)
+    return;
+  Internals& in = *this->Internal;
+  const vtkMTimeType before = this->TracingMTime();
+  this->Exposure = exposure;
+  this->Modified();
+  in.ExposureEditBefore = before;
+  in.ExposureEditAfter = this->GetMTime();
+}
+
+vtkMTimeType vtkMultiMaterialVolumeMapper::TracingMTime()
+{
+  // The mapper's modification time as far as tracing goes: an exposure
+  // edit (only DrawFilm reads it) with nothing modified after it leaves the
+  // time it had before, so the accumulation goes on.
+  const vtkMTimeType t = this->GetMTime();
+  return t == this->Internal->ExposureEditAfter ? this->Internal->ExposureEditBefore : t;
+}
+
 void vtkMultiMaterialVolumeMapper::SetMaskInput(vtkImageData* mask)
 {
   if (this->Internal->Mask != mask)
@@ -476,16 +515,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     vtkErrorMacro("Render: no input image or no volume property");
     return;
   }
-  if (!in.Warned && this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND)
-  {
+  if (in.Warn("blend mode", this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND))
     vtkWarningMacro("only composite blending is supported; rendering as composite");
-    in.Warned = true;
-  }
-  if (!in.Warned && this->Cropping && this->CroppingRegionFlags != VTK_CROP_SUBVOLUME)
-  {
+  if (in.Warn("cropping region", this->Cropping && this->CroppingRegionFlags != VTK_CROP_SUBVOLUME))
     vtkWarningMacro("only the subvolume cropping region (VTK_CROP_SUBVOLUME) is supported; not cropping");
-    in.Warned = true;
-  }
 
   int width = 0, height = 0, originX = 0, originY = 0;
   ren->GetTiledSizeAndOrigin(&width, &height, &originX, &originY);
@@ -514,7 +547,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         static_cast<double>(in.Mask ? in.Mask->GetMTime() : 0), object(property),
         static_cast<double>(PropertyMTime(property)), object(in.MultiMaterial.Get()),
         static_cast<double>(in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0),
-        static_cast<double>(in.LabelMaterialParametersTime.GetMTime()), static_cast<double>(this->GetMTime()),
+        static_cast<double>(in.LabelMaterialParametersTime.GetMTime()), static_cast<double>(this->TracingMTime()),
         static_cast<double>(in.EnvironmentTexture ? in.EnvironmentTexture->GetMTime() : 0) };
       for (float d : ReadDepth(ren, width, height, originX, originY))
         s.Exact.push_back(d);
@@ -570,16 +603,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       componentGradients != in.ComponentGradientsBuilt)
     {
       in.HasScene = false;  // until the rebuild succeeds
-      if (!in.Warned && components > 4 && independent)
-      {
+      if (in.Warn("components", components > 4 && independent))
         vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
-        in.Warned = true;
-      }
-      if (!in.Warned && independent && mask)
-      {
+      if (in.Warn("mask with components", independent && mask))
         vtkWarningMacro("with independent components, the mask is not used");
-        in.Warned = true;
-      }
       this->BuildProxies(property, input, scalars, dependent, independent, needGradient, labels);
       in.LightsFromScene = false;
       if (multi)
@@ -634,11 +661,11 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     for (const mmrtm::ClipPlane& p : clip)
       view.insert(view.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
     std::vector<float> depth = ReadDepth(ren, width, height, originX, originY);
-    if (!SameView(view, in.View) || depth != in.Depth || this->GetMTime() != in.MapperTime || !in.Film)
+    if (!SameView(view, in.View) || depth != in.Depth || this->TracingMTime() != in.MapperTime || !in.Film)
     {
       in.View = std::move(view);
       in.Depth = std::move(depth);
-      in.MapperTime = this->GetMTime();
+      in.MapperTime = this->TracingMTime();
       restart = true;
     }
 
@@ -703,7 +730,9 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       if (!in.LastExtinctionWarning.empty())
         vtkWarningMacro(<< in.LastExtinctionWarning);
     }
-    if (restart)  // the build after a change: a refit (or the summaries and a refit)
+    // A build that refitted (or built the summaries and refitted); one after
+    // a camera move keeps the majorants and takes microseconds.
+    if (restart && (in.Scene.GridRefittedByLastBuild() || !in.Scene.Grid()))
       in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
     const int accumulated = static_cast<int>(in.Film->Samples());
     const int samples = this->IsConverged() ? 0

@@ -19,11 +19,14 @@
  *   (GetNumberOfRefits());
  * - a change of the camera, a light, the viewport or the volume's matrix:
  *   the accumulation restarts (GetNumberOfRestarts());
+ * - the exposure: the accumulated samples are drawn again, not restarted;
  * - nothing changed: samples are added.
  *
  * The volume's matrix (vtkProp3D) is honoured, so oblique orientations and
  * non-uniform scales render correctly. The image is composited premultiplied
- * at the depth of the volume's nearest bounding-box corner.
+ * in front of everything else in the viewport: camera rays stop at the
+ * opaque geometry VTK drew first (its depth buffer), so where that geometry
+ * is in front the image is transparent.
  *
  * Clipping planes (world space) and subvolume cropping (data space) limit
  * what is seen. Not supported yet (a warning is given once): blend modes
@@ -194,9 +197,11 @@ public:
 
   ///@{
   /**
-   * Exposure multiplier before tone mapping (default 1).
+   * Exposure multiplier before tone mapping (default 1, at least 0). A
+   * change redraws the samples accumulated so far; it does not start the
+   * accumulation again.
    */
-  vtkSetClampMacro(Exposure, double, 0.0, VTK_DOUBLE_MAX);
+  virtual void SetExposure(double exposure);
   vtkGetMacro(Exposure, double);
   ///@}
 
@@ -337,9 +342,10 @@ public:
   int GetNumberOfMajorantGridBuilds();
 
   /**
-   * Seconds the scene's build took at the last restart: the refit of the
-   * majorants after a transfer-function change (with the grid's summaries
-   * after a data change). For status lines and benchmarks.
+   * Seconds the scene's build took the last time it refitted the
+   * majorants: after a transfer-function change (with the grid's summaries
+   * after a data change). A camera move or a settings edit does not refit.
+   * For status lines and benchmarks.
    */
   double GetLastRefitSeconds();
 
@@ -389,6 +395,7 @@ private:
   void FinishPass(bool cancel);
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
+  vtkMTimeType TracingMTime();
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;

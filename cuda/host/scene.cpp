@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <type_traits>
 
 namespace mmrtm {
 
@@ -32,7 +33,66 @@ float UniformInverseStep(const std::vector<float>& keys) {
   return (float)(1.0 / step);
 }
 
+// The bytes of what a refit of the majorant grid reads, field by field (no
+// struct padding): two equal keys give equal majorants, so an unchanged
+// render skips the refit without any front end having to say what changed.
+class RefitKey {
+ public:
+  template <typename T>
+  void Add(const T& v) {
+    static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T> || std::is_pointer_v<T>);
+    const auto* b = reinterpret_cast<const uint8_t*>(&v);
+    bytes_.insert(bytes_.end(), b, b + sizeof v);
+  }
+  template <typename T>
+  void AddAll(const std::vector<T>& values) {
+    Add(values.size());
+    for (const T& v : values) Add(v);
+  }
+  std::vector<uint8_t> Take() { return std::move(bytes_); }
+
+ private:
+  std::vector<uint8_t> bytes_;
+};
+
 }  // namespace
+
+std::vector<uint8_t> Scene::MakeRefitKey() const {
+  RefitKey k;
+  k.Add(render.accelerator.kind);
+  k.Add(proxies.size());
+  for (const HostVolume& v : proxies) {
+    k.Add(v.voxels.data());
+    k.Add(v.type);
+    k.Add(v.interpolation);
+    for (int a = 0; a < 3; ++a) k.Add(v.dims[a]);
+    for (const auto& row : v.indexToWorld.m)
+      for (float x : row) k.Add(x);
+  }
+  k.Add(tfs.size());
+  for (const TransferFunctionDesc& tf : tfs) {
+    k.Add(tf.type);
+    k.Add(tf.proxy);
+    k.Add(tf.channels);
+    k.AddAll(tf.keys);
+    k.AddAll(tf.values);
+    k.AddAll(tf.materials);
+  }
+  k.Add(materials.size());
+  for (const MaterialDesc& m : materials) {
+    for (float x : m.base) k.Add(x);
+    k.Add(m.bindings.size());
+    for (const MaterialDesc::Binding& b : m.bindings) {
+      k.Add(b.tf);
+      k.Add(b.quantity);
+    }
+  }
+  k.AddAll(selectors);
+  k.Add(defaultMaterial);
+  k.Add(gradientProxy);
+  k.Add(additiveMaterials);
+  return k.Take();
+}
 
 int Scene::ProxyIndex(const std::string& name) const {
   for (size_t i = 0; i < proxies.size(); ++i)
@@ -314,6 +374,7 @@ SceneView Scene::Build() {
     extinctionWarning_ = text;
   }
   gridBuilt_ = false;
+  gridRefitted_ = false;
   if (acc.kind != MajorantKind::Global) {
     const MajorantGridOptions& o = acc.grid;
     const bool layoutChanged = grid_ && (grid_->Options().leafLevel != o.leafLevel ||
@@ -325,7 +386,12 @@ SceneView Scene::Build() {
     } else {
       for (const auto& region : modifiedRegions_) grid_->UpdateRegion(proxies, region[0], region[1]);
     }
-    grid_->Refit(c);
+    std::vector<uint8_t> key = MakeRefitKey();
+    gridRefitted_ = gridBuilt_ || !modifiedRegions_.empty() || key != refitKey_;
+    if (gridRefitted_) {
+      grid_->Refit(c);
+      refitKey_ = std::move(key);
+    }
     s.majorants.grid = grid_->View();
   }
   dataModified_ = false;

@@ -132,6 +132,12 @@ class Scene {
   const MajorantGrid* Grid() const { return grid_.get(); }
   // Whether the last Build built the grid's summaries (not only a refit).
   bool GridSummariesBuiltByLastBuild() const { return gridBuilt_; }
+  // Whether the last Build refitted the grid's majorants. It does only when
+  // something a refit reads changed since the last refit (the TFs, the
+  // materials, the selectors, the proxies' buffers and geometry, the
+  // accelerator) or the summaries were built: an unchanged Build, or one
+  // after a camera or settings change, keeps the majorants it has.
+  bool GridRefittedByLastBuild() const { return gridRefitted_; }
 
   // A scene built anew from a description over the same voxels (a TF or
   // material edit in a scene file, the proxies moved over from `previous`)
@@ -145,6 +151,7 @@ class Scene {
   void Validate() const;
   float UnclampedGlobalMajorant() const;
   CameraView BuildCamera() const;
+  std::vector<uint8_t> MakeRefitKey() const;
 
   std::vector<float> floatPool_;
   std::vector<int> intPool_;
@@ -157,6 +164,8 @@ class Scene {
   std::vector<const uint8_t*> summarisedVoxels_;    // per proxy, the buffers of the last data load
   bool dataModified_ = true;
   bool gridBuilt_ = false;
+  bool gridRefitted_ = false;
+  std::vector<uint8_t> refitKey_;  // MakeRefitKey() at the last refit
   std::string extinctionWarning_;
   std::vector<std::array<std::array<int, 3>, 2>> modifiedRegions_;
 };

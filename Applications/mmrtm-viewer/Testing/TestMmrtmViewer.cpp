@@ -127,6 +127,35 @@ class TestMmrtmViewer : public QObject {
     QVERIFY2(MeanDifference(before, View(v.window)) > 0.002, "the image changed");
   }
 
+  // The settings panel sends the whole settings on every edit: sent again
+  // unchanged, they must keep the accumulation, and so must an exposure
+  // change (only drawing reads it). Catches a change guard that never
+  // matches (one compared compact with indented JSON: every edit refitted
+  // and restarted) and an exposure edit that restarts.
+  void unchangedSettingsAndExposureKeepTheAccumulation() {
+    Viewer v;
+    QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
+    QVERIFY(RefineTo(v.window, 8));
+    vtkMultiMaterialVolumeMapper* m = v.window.scene().Mapper();
+    const int refits = m->GetNumberOfRefits(), restarts = m->GetNumberOfRestarts();
+    const QImage before = View(v.window);
+    emit v.window.renderSettings()->settingsChanged();
+    QTest::qWait(300);  // the render the edit schedules
+    QCOMPARE(m->GetNumberOfRefits(), refits);
+    QCOMPARE(m->GetNumberOfRestarts(), restarts);
+    QCOMPARE(m->GetAccumulatedSamples(), 8);
+
+    mmrtm::viewer::RenderSettings s = v.window.renderSettings()->settings();
+    s.exposure *= 2;
+    v.window.renderSettings()->setSettings(s);
+    emit v.window.renderSettings()->settingsChanged();
+    QTest::qWait(300);
+    QCOMPARE(m->GetExposure(), s.exposure);
+    QCOMPARE(m->GetNumberOfRestarts(), restarts);
+    QCOMPARE(m->GetAccumulatedSamples(), 8);
+    QVERIFY2(MeanDifference(before, View(v.window)) > 0.01, "the exposure brightened the image");
+  }
+
   void hidingALabelChangesItsPixelsOnly() {
     Viewer v;
     QVERIFY(v.window.setPreset("ct-organs"));
