@@ -19,6 +19,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkVolumeProperty.h>
 
+#include "mmrtmVolumePropertyFunctions.h"
 #include "scene_json.h"
 
 namespace mmrtm {
@@ -77,7 +78,7 @@ bool IsConstantOne(vtkPiecewiseFunction* f) {
 
 bool UsesGradientOpacity(vtkVolumeProperty* property, int component) {
   return property && !property->GetDisableGradientOpacity(component) &&
-         !IsConstantOne(property->GetStoredGradientOpacity(component));
+         !IsConstantOne(HeldGradientOpacity(property, component));
 }
 
 namespace {
@@ -95,6 +96,12 @@ class FiniteFunctions {
   vtkColorTransferFunction* Of(vtkColorTransferFunction* f) {
     return Repaired<6>(
         f, [](vtkColorTransferFunction* c, const double* n) { c->AddRGBPoint(n[0], n[1], n[2], n[3], n[4], n[5]); });
+  }
+  // A function made here (a default), kept as long as this object.
+  template <class F>
+  F* Keep(vtkSmartPointer<F> f) {
+    keep_.emplace_back(f);
+    return f;
   }
   int replaced = 0;  // node values read as 0, nodes dropped
 
@@ -146,15 +153,20 @@ struct MaterialFunctions {
   vtkPiecewiseFunction* gradientOpacity = nullptr;  // null: not used
 };
 
-// Component c's own functions (its gradient opacity when it is used).
+// Component c's own functions (its gradient opacity when it is used); VTK's
+// default where the property holds none, made here, not in the property.
 MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c, FiniteFunctions& finite) {
   MaterialFunctions f;
-  f.opacity = finite.Of(property->GetScalarOpacity(c));
-  if (property->GetColorChannels(c) == 3)
-    f.color = finite.Of(property->GetRGBTransferFunction(c));
-  else
-    f.grey = finite.Of(property->GetGrayTransferFunction(c));
-  if (UsesGradientOpacity(property, c)) f.gradientOpacity = finite.Of(property->GetGradientOpacity(c));
+  vtkPiecewiseFunction* opacity = HeldScalarOpacity(property, c);
+  f.opacity = finite.Of(opacity ? opacity : finite.Keep(DefaultScalarOpacity()));
+  if (property->GetColorChannels(c) == 3) {
+    vtkColorTransferFunction* color = HeldRGBTransferFunction(property, c);
+    f.color = finite.Of(color ? color : finite.Keep(DefaultRGBTransferFunction()));
+  } else {
+    vtkPiecewiseFunction* grey = HeldGrayTransferFunction(property, c);
+    f.grey = finite.Of(grey ? grey : finite.Keep(DefaultGrayTransferFunction()));
+  }
+  if (UsesGradientOpacity(property, c)) f.gradientOpacity = finite.Of(HeldGradientOpacity(property, c));
   return f;
 }
 

@@ -37,6 +37,7 @@
 #include "film.h"
 #include "label_alignment.h"
 #include "mmrtmImageDataConversion.h"
+#include "mmrtmVolumePropertyFunctions.h"
 #include "mmrtmVtkSceneTranslation.h"
 #include "mmrtm/planted_defect.h"
 #include "render_backend.h"
@@ -122,7 +123,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   // TracingMTime gave it) and after.
   vtkMTimeType ExposureEditBefore = 0, ExposureEditAfter = 0;
 
-  int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0;
+  int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0, GridRefits = 0;
   std::string LastExtinctionWarning;  // said once per change (vtkWarningMacro)
   double LastBuildSeconds = 0;
   // While the interactor moves the camera: a preview at 1/PreviewFactor of
@@ -133,13 +134,31 @@ struct vtkMultiMaterialVolumeMapper::Internals
 
 namespace
 {
-// The latest modification among the property and its component and label
-// functions (editing a function does not touch the property's own MTime).
+// The property's modification time without the edits of its colour
+// functions: what the planted defect MapperColorRefit sees.
+vtkMTimeType MTimeWithoutColours(vtkVolumeProperty* p)
+{
+  vtkMTimeType t = p->vtkObject::GetMTime();
+  for (int c = 0; c < VTK_MAX_VRCOMP; ++c)
+    for (vtkPiecewiseFunction* f : { mmrtm::HeldScalarOpacity(p, c), mmrtm::HeldGradientOpacity(p, c) })
+      if (f)
+        t = std::max(t, f->GetMTime());
+  return t;
+}
+
+// The latest modification among the property and its functions.
+// vtkVolumeProperty::GetMTime counts the component functions it holds and
+// when label functions were set; a label function edited in place is
+// counted here. Nothing is created in the property (its getters would).
 vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
 {
-  vtkMTimeType t = 0;
+  const bool missColours = mmrtm::Planted(mmrtm::Defect::MapperColorRefit);
+  vtkMTimeType t = missColours ? MTimeWithoutColours(p) : p->GetMTime();
   if (vtkImageData* table = p->GetTransferFunction2D(0))
     t = std::max(t, table->GetMTime());
+  for (const vtkTimeStamp& set : { p->GetLabelColorMTime(), p->GetLabelScalarOpacityMTime(),
+         p->GetLabelGradientOpacityMTime() })
+    t = std::max(t, set.GetMTime());
   for (int label : p->GetLabelMapLabels())
   {
     if (vtkPiecewiseFunction* f = p->GetLabelScalarOpacity(label))
@@ -147,24 +166,9 @@ vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
     if (vtkPiecewiseFunction* f = p->GetLabelGradientOpacity(label))
       t = std::max(t, f->GetMTime());
     if (vtkColorTransferFunction* f = p->GetLabelColor(label))
-      t = std::max(t, mmrtm::Planted(mmrtm::Defect::MapperColorRefit) ? 0 : f->GetMTime());
+      t = std::max(t, missColours ? 0 : f->GetMTime());
   }
-  for (int c = 0; c < 4; ++c)  // independent components have functions of their own
-  {
-    t = std::max(t, p->GetScalarOpacity(c)->GetMTime());
-    t = std::max(t, p->GetGradientOpacity(c)->GetMTime());
-    if (mmrtm::Planted(mmrtm::Defect::MapperColorRefit))
-      continue;
-    if (p->GetColorChannels(c) == 3)
-      t = std::max(t, p->GetRGBTransferFunction(c)->GetMTime());
-    else
-      t = std::max(t, p->GetGrayTransferFunction(c)->GetMTime());
-  }
-  // Last: asking for a component's function the first time creates a
-  // default one and modifies the property.
-  if (mmrtm::Planted(mmrtm::Defect::MapperColorRefit))
-    return std::max(t, p->vtkObject::GetMTime());  // vtkVolumeProperty's own counts the colour functions
-  return std::max(t, p->GetMTime());
+  return t;
 }
 
 // Camera, lights, the volume's matrix and the viewport, as values: a change
@@ -485,6 +489,11 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfMajorantGridBuilds()
   return this->Internal->GridBuilds;
 }
 
+int vtkMultiMaterialVolumeMapper::GetNumberOfMajorantGridRefits()
+{
+  return this->Internal->GridRefits;
+}
+
 int vtkMultiMaterialVolumeMapper::GetNumberOfRefits()
 {
   return this->Internal->Refits;
@@ -724,6 +733,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     const auto buildStart = std::chrono::steady_clock::now();
     const mmrtm::SceneView sceneView = in.Scene.Build();
     in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
+    in.GridRefits += in.Scene.GridRefittedByLastBuild() ? 1 : 0;
     if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning)  // once per change, not per render
     {
       in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
@@ -1027,6 +1037,8 @@ void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, in
     in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, depth, w, h);
   }
   const mmrtm::SceneView view = in.Scene.Build();
+  in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
+  in.GridRefits += in.Scene.GridRefittedByLastBuild() ? 1 : 0;
   in.Preview = std::make_unique<mmrtm::Film>(w, h);
   const auto start = std::chrono::steady_clock::now();
   in.Renderer->Render(in.Scene, view, *in.Preview, 1, nullptr, nullptr);

@@ -342,6 +342,13 @@ public:
   int GetNumberOfMajorantGridBuilds();
 
   /**
+   * How often the majorant grid's majorants were refitted: after a change
+   * of what the refit reads (the transfer functions, the materials, the
+   * data), not after a camera, light or settings change.
+   */
+  int GetNumberOfMajorantGridRefits();
+
+  /**
    * Seconds the scene's build took the last time it refitted the
    * majorants: after a transfer-function change (with the grid's summaries
    * after a data change). A camera move or a settings edit does not refit.

@@ -4,7 +4,7 @@
 // A leaf's summary is, per proxy, the 256-bin set of values the proxy can
 // take in it (majorant_grid.h). Most leaves share theirs with many others
 // (empty air, uniform tissue, one label): the five reference scenes of
-// Documentation/accuracy.md have 5,000 to 16,000 distinct summaries among
+// Documentation/accuracy.md have 5,200 to 22,400 distinct summaries among
 // 93,000 to 380,000 leaves. So the table keeps each distinct summary (the
 // tuple of its proxies' words) once and a leaf holds the 4-byte id of its
 // own: 4 bytes a leaf instead of 32 per proxy, and a refit bounds each
