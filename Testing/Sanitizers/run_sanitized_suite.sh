@@ -56,6 +56,7 @@ if [ "$sanitizers" = thread ]; then
   # other two hundred tests here, and what TSan looks for is in the threads,
   # not in the number of samples. ASan+UBSan runs them.
   statistical="ImageCT\.|Furnace|Unbiased\.|SurfaceScene\.|LightSampling\.EveryMode|AdaptiveSampling\.Agrees"
+  statistical+="|vtkMapper-(ct-bone|oblique|labels|rgba|mesh)$"
   "${norandom[@]}" ctest --test-dir "$build" -j"$(nproc)" --output-on-failure -E "accuracy|vtk96|viewer-|$statistical" \
     --timeout 1800
 else
