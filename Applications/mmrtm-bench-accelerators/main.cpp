@@ -264,8 +264,8 @@ int main(int argc, char** argv) {
       r.meanZ2 = MeanSquaredZScore(noneFilm, film);
       results.push_back(r);
       std::printf("%-20s %-20s %5d %9.2f %9.2f %9.2f %9.1f %9.2f %8.2f %8.2f %7.3f%s\n", d.name.c_str(),
-                  c.name.c_str(), r.leafLevel, r.build * 1e3, r.refit * 1e3, r.unchanged * 1e6, r.locate * 1e3, r.render, noneRender / r.render,
-                  r.lookupsPerReal, r.meanZ2, r.violations ? "  (majorant violations!)" : "");
+                  c.name.c_str(), r.leafLevel, r.build * 1e3, r.refit * 1e3, r.unchanged * 1e6, r.locate * 1e3,
+                  r.render, noneRender / r.render, r.lookupsPerReal, r.meanZ2, r.violations ? "  (majorant violations!)" : "");
       std::fflush(stdout);
     }
   }

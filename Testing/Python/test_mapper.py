@@ -532,7 +532,7 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(said("only the first 4 of 5 independent components"), 1, warnings.messages)
         # A mask as well: its own warning; the components' cause still holds, not said again.
-        threshold, _ = s.add_bone_labels((1.0, 0.2, 0.2))
+        s.add_bone_labels((1.0, 0.2, 0.2))
         s.render()
         s.render()
         self.assertEqual(said("with independent components, the mask is not used"), 1, warnings.messages)

@@ -8,10 +8,11 @@
 # address,undefined: every C++ test; leaks too where no OpenGL driver is
 # loaded, but for the suppressions in lsan.supp, each with its reason.
 # thread: the same tests but the viewer's and the statistical ones (each
-# renders on the CPU tile pool; the mapper's asynchronous refinement and the
-# soak add their threads), with the suppressions in tsan.supp. The viewer's QTests are
-# left out: Qt 6 synchronises its threads through futexes that TSan cannot
-# see in Debian's uninstrumented Qt, so every queued signal reads as a race;
+# renders on the CPU tile pool; the mapper's asynchronous refinement and
+# the soak add their threads), with the suppressions in tsan.supp. The
+# viewer's QTests are left out: Qt 6 synchronises its threads through
+# futexes that TSan cannot see in Debian's uninstrumented Qt, so every
+# queued signal reads as a race;
 # the viewer's refinement thread is the mapper's, which the soak covers.
 # Left out: the Python suites (CPython and VTK's Python are not
 # instrumented) and the accuracy checks (minutes of rendering, unchanged by

@@ -124,6 +124,12 @@ struct vtkMultiMaterialVolumeMapper::Internals
   vtkMTimeType ExposureEditBefore = 0, ExposureEditAfter = 0;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0, GridRefits = 0;
+  // After a Scene.Build: what it did to the majorant grid.
+  void CountGridWork()
+  {
+    this->GridBuilds += this->Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
+    this->GridRefits += this->Scene.GridRefittedByLastBuild() ? 1 : 0;
+  }
   std::string LastExtinctionWarning;  // said once per change (vtkWarningMacro)
   double LastBuildSeconds = 0;
   // While the interactor moves the camera: a preview at 1/PreviewFactor of
@@ -732,8 +738,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     in.Preview.reset();
     const auto buildStart = std::chrono::steady_clock::now();
     const mmrtm::SceneView sceneView = in.Scene.Build();
-    in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
-    in.GridRefits += in.Scene.GridRefittedByLastBuild() ? 1 : 0;
+    in.CountGridWork();
     if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning)  // once per change, not per render
     {
       in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
@@ -1037,8 +1042,7 @@ void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, in
     in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, depth, w, h);
   }
   const mmrtm::SceneView view = in.Scene.Build();
-  in.GridBuilds += in.Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
-  in.GridRefits += in.Scene.GridRefittedByLastBuild() ? 1 : 0;
+  in.CountGridWork();
   in.Preview = std::make_unique<mmrtm::Film>(w, h);
   const auto start = std::chrono::steady_clock::now();
   in.Renderer->Render(in.Scene, view, *in.Preview, 1, nullptr, nullptr);
