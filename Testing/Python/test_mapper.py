@@ -543,7 +543,19 @@ class MapperTest(unittest.TestCase):
         s.mapper.SetBlendModeToMaximumIntensity()
         s.render()
         self.assertEqual(said("only composite blending"), 2, warnings.messages)
-        self.assertEqual(len(warnings.messages), 5, warnings.messages)
+        # More clipping planes than the tracer takes (12): its own warning, once.
+        planes = vtkPlaneCollection()
+        bounds = s.mapper.GetBounds()
+        for _ in range(13):
+            plane = vtkPlane()
+            plane.SetOrigin(bounds[0], bounds[2], bounds[4])
+            plane.SetNormal(1, 0, 0)  # keeps the whole volume
+            planes.AddItem(plane)
+        s.mapper.SetClippingPlanes(planes)
+        s.render()
+        s.render()
+        self.assertEqual(said("clipping and cropping planes are used"), 1, warnings.messages)
+        self.assertEqual(len(warnings.messages), 6, warnings.messages)
 
     def test_noise_target_stops_the_refinement(self):
         s = Scene()

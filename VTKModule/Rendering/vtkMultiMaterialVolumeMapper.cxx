@@ -47,8 +47,50 @@
 
 vtkStandardNewMacro(vtkMultiMaterialVolumeMapper);
 
-// What the mapper keeps between renders, and the modification times that
-// decide how much of it a render must redo.
+// What a render reads, in three parts, each of which decides one phase's
+// work: the proxies (voxels, mask, the components the property uses), the
+// materials (the property, the multi-material description, the label
+// parameters) and the view (camera, lights, viewport, clipping, opaque
+// geometry, environment, the mapper's tracing settings). Modification
+// times where VTK keeps them; the view by value (SameView).
+struct vtkMultiMaterialVolumeMapper::InputState
+{
+  // Proxies.
+  vtkImageData* Data = nullptr;
+  vtkMTimeType DataTime = 0;
+  vtkImageData* Mask = nullptr;
+  vtkMTimeType MaskTime = 0;
+  int MaskType = -1;
+  vtkMultiMaterialProperty* MultiMaterial = nullptr;
+  vtkDataArray* Scalars = nullptr;
+  int Dependent = -1;    // components used as colour + opacity (IndependentComponents off)
+  int Independent = -1;  // components mixed additively (IndependentComponents on)
+  int ComponentGradients = -1;  // independent components with gradient opacity (bit c)
+  bool NeedGradient = false;    // a gradient-magnitude proxy (without a description)
+
+  // Materials.
+  vtkVolumeProperty* Property = nullptr;
+  vtkMTimeType PropertyTime = 0, MultiMaterialTime = 0, LabelParametersTime = 0;
+
+  // View.
+  int Width = 0, Height = 0;  // the viewport's
+  std::vector<double> View;   // with the size, compared by SameView
+  std::vector<mmrtm::ClipPlane> Clip;
+  std::vector<float> Depth;  // the depth buffer under the volume
+  vtkMTimeType TracingTime = 0;
+};
+
+// Which phases a render must run: the answer of ChangesSince.
+struct vtkMultiMaterialVolumeMapper::Changes
+{
+  bool Proxies = false;      // made again from the input (and the description parsed over them)
+  bool Description = false;  // the description parsed again over the proxies as they are
+  bool Materials = false;    // the property translated again
+  bool View = false;         // the camera, lights and settings set again
+  bool Any() const { return this->Proxies || this->Description || this->Materials || this->View; }
+};
+
+// What the mapper keeps between renders, and the inputs it was made from.
 struct vtkMultiMaterialVolumeMapper::Internals
 {
   mmrtm::Scene Scene;
@@ -66,27 +108,18 @@ struct vtkMultiMaterialVolumeMapper::Internals
   mmrtm::ProxyLayout Layout;
   vtkSmartPointer<vtkImageData> Mask;
   vtkSmartPointer<vtkMultiMaterialProperty> MultiMaterial;
-  vtkMTimeType MultiMaterialTime = 0;
   bool LightsFromScene = false;  // the multi-material description has its own lights
   vtkSmartPointer<vtkTexture> EnvironmentTexture;
   std::shared_ptr<mmrtm::EnvironmentMap> Environment;  // converted from the texture
   vtkMTimeType EnvironmentTime = 0;
   double EnvironmentScale = 0;
-  int MaskTypeBuilt = -1;
-  int DependentBuilt = -1;    // components used as colour + opacity (IndependentComponents off)
-  int IndependentBuilt = -1;  // components mixed additively (IndependentComponents on)
-  int ComponentGradientsBuilt = -1;
-
-  vtkDataObject* Data = nullptr;
-  vtkMTimeType MaskTime = 0;
-  vtkMTimeType DataTime = 0, PropertyTime = 0, MapperTime = 0;
   // SetLabelMaterialParameters, by label, and when they last changed.
   std::map<int, std::string> LabelMaterialParameters;
   vtkTimeStamp LabelMaterialParametersTime;
-  vtkMTimeType LabelMaterialParametersBuilt = 0;
-  std::vector<double> View;
-  std::vector<float> Depth;  // the depth buffer under the volume at the last restart
-  bool HasScene = false;
+  // The inputs as the scene and the film were last made from them; each
+  // render compares what it finds with these (ChangesSince).
+  InputState Built;
+  bool HasScene = false;  // false until a build succeeds, and after a failed one
 
   // Whether each warning's cause held when it was last checked: a warning
   // is said when its cause appears, and again only after the cause went
@@ -103,8 +136,9 @@ struct vtkMultiMaterialVolumeMapper::Internals
 
   // Asynchronous refinement: the pass in flight adds samples to Film on a
   // thread of its own while renders draw Shown (Film as of the last pass
-  // that finished). Stamp is what the pass was started under: a render
-  // that finds anything else stops the pass (between tiles) first.
+  // that finished). A pass starts only when nothing changed, so it runs
+  // under Built: a render that finds any change stops it (between tiles)
+  // first.
   struct Pass
   {
     std::thread Thread;
@@ -113,11 +147,6 @@ struct vtkMultiMaterialVolumeMapper::Internals
   };
   std::unique_ptr<Pass> InFlight;
   std::unique_ptr<mmrtm::Film> Shown;
-  struct Stamp
-  {
-    std::vector<double> View;     // compared as views are (SameView)
-    std::vector<double> Exact;    // modification times, objects, depth, settings
-  } PassStamp;
 
   // The last exposure edit: the mapper's modification time before it (as
   // TracingMTime gave it) and after.
@@ -363,9 +392,7 @@ void vtkMultiMaterialVolumeMapper::SetMultiMaterialProperty(vtkMultiMaterialProp
 {
   if (this->Internal->MultiMaterial != property)
   {
-    this->Internal->MultiMaterial = property;
-    this->Internal->MultiMaterialTime = 0;
-    this->Internal->HasScene = false;  // another source of materials: the proxies are made again
+    this->Internal->MultiMaterial = property;  // another source of materials: the proxies are made again
     this->Modified();
   }
 }
@@ -520,275 +547,315 @@ const char* vtkMultiMaterialVolumeMapper::GetBackendDescription()
   return this->Internal->BackendDescription.c_str();
 }
 
+// The phases of a render, as vtkGPUVolumeRayCastMapper has them: validate,
+// read the inputs and compare them with what the scene was made from, stop
+// a pass in flight that they outdate, update the proxies, the materials and
+// the view as far as they changed, refine, draw.
 void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   Internals& in = *this->Internal;
-  vtkImageData* input = vtkImageData::SafeDownCast(this->GetInput());
-  vtkVolumeProperty* property = vol->GetProperty();
-  if (!input || !property)
+  int viewport[4] = { 0, 0, 0, 0 };  // width, height, origin x, origin y
+  if (!this->ValidateInputs(ren, vol, viewport))
+    return;
+  try
+  {
+    InputState now = this->ReadInputs(ren, vol, viewport);
+    const Changes changes = this->ChangesSince(in.Built, now);
+
+    // Asynchronous refinement: a pass in flight goes on while nothing
+    // changed (the last finished image is drawn); else it is stopped.
+    vtkRenderWindow* window = ren->GetRenderWindow();
+    const bool interactive = this->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0;
+    if (in.InFlight)
+    {
+      if (!in.InFlight->Done && !interactive && !changes.Any())
+      {
+        if (in.Shown)
+          this->DrawFilm(ren, vol, *in.Shown);
+        return;
+      }
+      this->FinishPass(!in.InFlight->Done);  // a stopped pass leaves no film: a restart
+    }
+
+    if (changes.Proxies)
+      this->UpdateProxies(now);
+    else if (changes.Description)
+      this->UpdateDescription(now);
+    if (!now.MultiMaterial && (changes.Proxies || changes.Materials))
+      this->UpdateMaterials(now);
+    const bool restart = changes.Any() || !in.Film;
+    if (restart)
+      this->UpdateView(ren, vol, now);
+    this->UpdateRenderer();
+
+    if (interactive)
+    {
+      this->RenderPreview(ren, viewport[0], viewport[1], 1.0 / window->GetDesiredUpdateRate());
+      this->DrawFilm(ren, vol, *in.Preview);
+      return;
+    }
+    in.Preview.reset();
+    if (const mmrtm::Film* film = this->Refine(restart))
+      this->DrawFilm(ren, vol, *film);
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro("Render: " << e.what());
+  }
+}
+
+bool vtkMultiMaterialVolumeMapper::ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4])
+{
+  Internals& in = *this->Internal;
+  if (!this->GetInput() || !vol->GetProperty())
   {
     vtkErrorMacro("Render: no input image or no volume property");
-    return;
+    return false;
   }
   if (in.Warn("blend mode", this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND))
     vtkWarningMacro("only composite blending is supported; rendering as composite");
   if (in.Warn("cropping region", this->Cropping && this->CroppingRegionFlags != VTK_CROP_SUBVOLUME))
     vtkWarningMacro("only the subvolume cropping region (VTK_CROP_SUBVOLUME) is supported; not cropping");
+  ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
+  return viewport[0] > 0 && viewport[1] > 0;
+}
 
-  int width = 0, height = 0, originX = 0, originY = 0;
-  ren->GetTiledSizeAndOrigin(&width, &height, &originX, &originY);
-  if (width <= 0 || height <= 0)
-    return;
+vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInputs(
+  vtkRenderer* ren, vtkVolume* vol, const int viewport[4])
+{
+  Internals& in = *this->Internal;
+  InputState now;
+  // The input brought up to date (a new or modified input rebuilds).
+  this->GetInputAlgorithm()->UpdateInformation();
+  this->GetInputAlgorithm()->Update();
+  now.Data = vtkImageData::SafeDownCast(this->GetInput());
+  if (!now.Data)
+    throw mmrtm::InputError("the input is not a vtkImageData");
+  now.DataTime = now.Data->GetMTime();
+  now.Mask = in.Mask;
+  now.MaskTime = in.Mask ? in.Mask->GetMTime() : 0;
+  now.MaskType = this->MaskType;
+  now.MultiMaterial = in.MultiMaterial;
+  int cellFlag = 0;
+  now.Scalars = vtkAbstractMapper::GetScalars(
+    now.Data, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+  if (!now.Scalars || cellFlag)
+    throw mmrtm::InputError("the input needs point scalars");
 
-  try
+  // The proxies the property asks for.
+  vtkVolumeProperty* property = vol->GetProperty();
+  const int components = now.Scalars->GetNumberOfComponents();
+  now.Dependent = !property->GetIndependentComponents() && (components == 2 || components == 4) ? components : 0;
+  now.Independent = property->GetIndependentComponents() && components > 1 ? std::min(components, 4) : 0;
+  // 4 dependent components fill the 4 proxies: no room for a gradient.
+  const bool labels = in.Mask && this->MaskType == LABELMAP;
+  now.NeedGradient = !in.MultiMaterial && now.Dependent != 4 && !now.Independent &&
+    mmrtm::NeedsGradientProxy(property, 0, labels);
+  now.ComponentGradients = 0;
+  for (int c = 0; c < now.Independent; ++c)
+    now.ComponentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
+  if (in.Warn("components", components > 4 && now.Independent))
+    vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
+  if (in.Warn("mask with components", now.Independent && in.Mask))
+    vtkWarningMacro("with independent components, the mask is not used");
+
+  now.Property = property;
+  now.PropertyTime = PropertyMTime(property);
+  now.MultiMaterialTime = in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0;
+  now.LabelParametersTime = in.LabelMaterialParametersTime.GetMTime();
+
+  // Camera, lights, matrix, viewport (by value), clipping, the environment,
+  // the opaque geometry (its depth), and the mapper's own settings.
+  now.Width = viewport[0];
+  now.Height = viewport[1];
+  now.View = ViewSignature(ren, vol, now.Width, now.Height);
+  now.Clip = this->ClipPlanes(vol);
+  for (const mmrtm::ClipPlane& p : now.Clip)
+    now.View.insert(now.View.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
+  this->UpdateEnvironment();
+  now.View.push_back(static_cast<double>(in.EnvironmentTime));
+  now.Depth = ReadDepth(ren, viewport[0], viewport[1], viewport[2], viewport[3]);
+  now.TracingTime = this->TracingMTime();
+  return now;
+}
+
+vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince(
+  const InputState& built, const InputState& now)
+{
+  Changes c;
+  c.Proxies = !this->Internal->HasScene || now.Data != built.Data || now.DataTime != built.DataTime ||
+    now.Mask != built.Mask || now.MaskTime != built.MaskTime || now.MaskType != built.MaskType ||
+    now.MultiMaterial != built.MultiMaterial || now.Dependent != built.Dependent ||
+    now.Independent != built.Independent || now.ComponentGradients != built.ComponentGradients ||
+    now.NeedGradient != built.NeedGradient;
+  c.Description = now.MultiMaterial && now.MultiMaterialTime != built.MultiMaterialTime;
+  c.Materials = !now.MultiMaterial &&
+    (now.Property != built.Property || now.PropertyTime != built.PropertyTime ||
+      now.LabelParametersTime != built.LabelParametersTime);
+  c.View = !SameView(now.View, built.View) || now.Depth != built.Depth || now.TracingTime != built.TracingTime;
+  return c;
+}
+
+void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
+{
+  Internals& in = *this->Internal;
+  in.HasScene = false;  // until the rebuild succeeds
+  const bool labels = now.Mask && now.MaskType == LABELMAP;
+  this->BuildProxies(
+    now.Property, now.Data, now.Scalars, now.Dependent, now.Independent, now.NeedGradient, labels);
+  in.LightsFromScene = false;
+  if (now.MultiMaterial)
+    this->ParseMultiMaterialScene();
+  for (const mmrtm::HostVolume& v : in.Scene.proxies)
+    in.ImageIndexToWorld.push_back(v.indexToWorld);
+  in.Scene.MarkDataModified();
+  InputState& built = in.Built;
+  built.Data = now.Data;
+  built.DataTime = now.DataTime;
+  built.Mask = now.Mask;
+  built.MaskTime = now.MaskTime;
+  built.MaskType = now.MaskType;
+  built.MultiMaterial = now.MultiMaterial;
+  built.MultiMaterialTime = now.MultiMaterialTime;
+  built.Dependent = now.Dependent;
+  built.Independent = now.Independent;
+  built.ComponentGradients = now.ComponentGradients;
+  built.NeedGradient = now.NeedGradient;
+  ++in.SceneBuilds;
+}
+
+void vtkMultiMaterialVolumeMapper::UpdateDescription(const InputState& now)
+{
+  // An edited description over unchanged data: parsed again over the
+  // proxies as they are, and refitted.
+  this->ReparseMultiMaterialScene();
+  this->Internal->Built.MultiMaterialTime = now.MultiMaterialTime;
+}
+
+void vtkMultiMaterialVolumeMapper::UpdateMaterials(const InputState& now)
+{
+  // The transfer functions translated again (the scene's build refits).
+  Internals& in = *this->Internal;
+  if (const int nonFinite = mmrtm::SetMaterialsFromProperty(now.Property, 0, in.Layout, in.Scene))
+    vtkWarningMacro(<< "the volume property holds " << nonFinite
+                    << " value(s) that are not finite (NaN in a transfer function or a component "
+                       "weight); they were read as 0");
+  if (in.Layout.labels >= 0)
   {
-    // Data: a new or modified input rebuilds the proxies and the grid's summaries.
-    this->GetInputAlgorithm()->UpdateInformation();
-    this->GetInputAlgorithm()->Update();
-
-    // Asynchronous refinement: a pass in flight goes on while nothing it
-    // depends on changed (the last finished image is drawn); else it is
-    // stopped, and this render goes on as usual.
-    vtkRenderWindow* window = ren->GetRenderWindow();
-    const bool interactive = this->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0;
-    auto stampNow = [&]() {
-      Internals::Stamp s;
-      s.View = ViewSignature(ren, vol, width, height);
-      for (const mmrtm::ClipPlane& p : this->ClipPlanes(vol))
-        s.View.insert(s.View.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
-      auto object = [](const void* p) { return static_cast<double>(reinterpret_cast<uintptr_t>(p)); };
-      vtkDataObject* data = this->GetInput();
-      s.Exact = { object(data), static_cast<double>(data ? data->GetMTime() : 0), object(in.Mask.Get()),
-        static_cast<double>(in.Mask ? in.Mask->GetMTime() : 0), object(property),
-        static_cast<double>(PropertyMTime(property)), object(in.MultiMaterial.Get()),
-        static_cast<double>(in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0),
-        static_cast<double>(in.LabelMaterialParametersTime.GetMTime()), static_cast<double>(this->TracingMTime()),
-        static_cast<double>(in.EnvironmentTexture ? in.EnvironmentTexture->GetMTime() : 0) };
-      for (float d : ReadDepth(ren, width, height, originX, originY))
-        s.Exact.push_back(d);
-      return s;
-    };
-    if (in.InFlight)
-    {
-      if (!in.InFlight->Done && !interactive)
-      {
-        const Internals::Stamp now = stampNow();
-        if (now.Exact == in.PassStamp.Exact && SameView(now.View, in.PassStamp.View))
-        {
-          if (in.Shown)
-            this->DrawFilm(ren, vol, *in.Shown);
-          return;
-        }
-      }
-      this->FinishPass(!in.InFlight->Done);
-    }
-
-    input = vtkImageData::SafeDownCast(this->GetInput());
-    if (!input)
-      throw mmrtm::InputError("the input is not a vtkImageData");
-    bool restart = false;
-    vtkImageData* mask = in.Mask;
-    const vtkMTimeType maskTime = mask ? mask->GetMTime() : 0;
-    const bool labels = mask && this->MaskType == LABELMAP;
-    int cellFlag = 0;
-    vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
-      input, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
-    if (!scalars || cellFlag)
-      throw mmrtm::InputError("the input needs point scalars");
-    const int components = scalars->GetNumberOfComponents();
-    const int dependent =
-      !property->GetIndependentComponents() && (components == 2 || components == 4) ? components : 0;
-    const int independent =
-      property->GetIndependentComponents() && components > 1 ? std::min(components, 4) : 0;
-    // 4 dependent components fill the 4 proxies: no room for a gradient.
-    const bool needGradient = dependent != 4 && !independent && mmrtm::NeedsGradientProxy(property, 0, labels);
-    // Independent components: which of them use gradient opacity (bit c).
-    int componentGradients = 0;
-    for (int c = 0; c < independent; ++c)
-      componentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
-    vtkMultiMaterialProperty* multi = in.MultiMaterial;
-    const vtkMTimeType multiTime = multi ? multi->GetMTime() : 0;
-    // An edited description over unchanged data is parsed again over the
-    // proxies as they are, and refits (below).
-    const bool newDescription = multi && multiTime != in.MultiMaterialTime;
-    in.MultiMaterialTime = multiTime;
-    if (input != in.Data || input->GetMTime() != in.DataTime || !in.HasScene || maskTime != in.MaskTime ||
-      this->MaskType != in.MaskTypeBuilt || (!multi && needGradient != (in.Layout.gradient >= 0)) ||
-      dependent != in.DependentBuilt || independent != in.IndependentBuilt ||
-      componentGradients != in.ComponentGradientsBuilt)
-    {
-      in.HasScene = false;  // until the rebuild succeeds
-      if (in.Warn("components", components > 4 && independent))
-        vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
-      if (in.Warn("mask with components", independent && mask))
-        vtkWarningMacro("with independent components, the mask is not used");
-      this->BuildProxies(property, input, scalars, dependent, independent, needGradient, labels);
-      in.LightsFromScene = false;
-      if (multi)
-        this->ParseMultiMaterialScene();
-      for (const mmrtm::HostVolume& v : in.Scene.proxies)
-        in.ImageIndexToWorld.push_back(v.indexToWorld);
-      in.Scene.MarkDataModified();
-      in.Data = input;
-      in.DataTime = input->GetMTime();
-      in.MaskTime = maskTime;
-      in.MaskTypeBuilt = this->MaskType;
-      in.DependentBuilt = dependent;
-      in.IndependentBuilt = independent;
-      in.ComponentGradientsBuilt = componentGradients;
-      in.PropertyTime = 0;  // translate the property again
-      ++in.SceneBuilds;
-      restart = true;
-    }
-    else if (newDescription)
-    {
-      this->ReparseMultiMaterialScene();
-      restart = true;
-    }
-
-    // Transfer functions: translated again and refitted.
-    const vtkMTimeType propertyTime = PropertyMTime(property);
-    if (!multi &&
-      (propertyTime != in.PropertyTime ||
-        in.LabelMaterialParametersTime.GetMTime() != in.LabelMaterialParametersBuilt))
-    {
-      if (const int nonFinite = mmrtm::SetMaterialsFromProperty(property, 0, in.Layout, in.Scene))
-        vtkWarningMacro(<< "the volume property holds " << nonFinite
-                        << " value(s) that are not finite (NaN in a transfer function or a component "
-                           "weight); they were read as 0");
-      if (in.Layout.labels >= 0)
-      {
-        for (const auto& [label, json] : in.LabelMaterialParameters)
-          mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
-      }
-      in.PropertyTime = propertyTime;
-      in.LabelMaterialParametersBuilt = in.LabelMaterialParametersTime.GetMTime();
-      ++in.Refits;
-      restart = true;
-    }
-
-    // View: camera, lights, matrix, viewport (by value), the opaque
-    // geometry (its depth), and the mapper's own settings.
-    std::vector<double> view = ViewSignature(ren, vol, width, height);
-    const std::vector<mmrtm::ClipPlane> clip = this->ClipPlanes(vol);
-    this->UpdateEnvironment();
-    view.push_back(static_cast<double>(in.EnvironmentTime));
-    for (const mmrtm::ClipPlane& p : clip)
-      view.insert(view.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
-    std::vector<float> depth = ReadDepth(ren, width, height, originX, originY);
-    if (!SameView(view, in.View) || depth != in.Depth || this->TracingMTime() != in.MapperTime || !in.Film)
-    {
-      in.View = std::move(view);
-      in.Depth = std::move(depth);
-      in.MapperTime = this->TracingMTime();
-      restart = true;
-    }
-
-    if (restart)
-    {
-      vol->GetMatrix(in.Matrix);
-      const mmrtm::Affine3 propMatrix = ToAffine(in.Matrix);
-      for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
-        in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
-      mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
-      // Camera rays stop at opaque geometry: it hides the volume behind it,
-      // and the volume in front of it hides it.
-      in.Scene.cameraRayMaxDistance =
-        in.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, in.Depth, width, height);
-      if (!in.LightsFromScene)
-        mmrtm::SetLightsFromVtk(ren, property, in.Scene);
-      if (in.Environment)
-        in.Scene.environment = in.Environment;
-      in.Scene.clipPlanes = clip;
-      mmrtm::RenderSettings& rs = in.Scene.render;
-      rs.width = width;
-      rs.height = height;
-      rs.threads = this->NumberOfThreads;
-      rs.exposure = static_cast<float>(this->Exposure);
-      rs.integrator.seed = static_cast<uint64_t>(this->Seed);
-      rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
-      rs.integrator.maxBounces = this->MaximumBounces;
-      rs.integrator.sampler =
-        this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
-      rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
-        : this->Accelerator == NO_ACCELERATOR             ? mmrtm::MajorantKind::Global
-                                                          : mmrtm::MajorantKind::Octree;
-      rs.integrator.backgroundVisible = false;  // VTK's background shows through
-      in.Film = std::make_unique<mmrtm::Film>(width, height);
-      in.HasScene = true;
-      ++in.Restarts;
-    }
-    if (!in.Renderer || in.RendererBackend != this->Backend || in.RendererThreads != this->NumberOfThreads)
-    {
-      const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
-        : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
-                                                          : mmrtm::Backend::Auto;
-      in.Renderer = mmrtm::MakeRenderer(backend, this->NumberOfThreads,
-        [this](const std::string& note) { vtkDebugMacro(<< note); });
-      in.RendererBackend = this->Backend;
-      in.RendererThreads = this->NumberOfThreads;
-      in.BackendDescription = in.Renderer->Description();
-    }
-    if (interactive)
-    {
-      this->RenderPreview(ren, width, height, 1.0 / window->GetDesiredUpdateRate());
-      this->DrawFilm(ren, vol, *in.Preview);
-      return;
-    }
-    in.Preview.reset();
-    const auto buildStart = std::chrono::steady_clock::now();
-    const mmrtm::SceneView sceneView = in.Scene.Build();
-    in.CountGridWork();
-    if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning)  // once per change, not per render
-    {
-      in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
-      if (!in.LastExtinctionWarning.empty())
-        vtkWarningMacro(<< in.LastExtinctionWarning);
-    }
-    // A build that refitted (or built the summaries and refitted); one after
-    // a camera move keeps the majorants and takes microseconds.
-    if (restart && (in.Scene.GridRefittedByLastBuild() || !in.Scene.Grid()))
-      in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
-    const int accumulated = static_cast<int>(in.Film->Samples());
-    const int samples = this->IsConverged() ? 0
-      : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
-                                            : this->SamplesPerRender;
-    if (samples > 0 && this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown)
-    {
-      // The next pass on a thread of its own; this render draws the last.
-      in.PassStamp = stampNow();
-      auto pass = std::make_unique<Internals::Pass>();
-      Internals::Pass* p = pass.get();
-      mmrtm::Renderer* renderer = in.Renderer.get();
-      mmrtm::Film* film = in.Film.get();
-      const mmrtm::Scene* scene = &in.Scene;
-      p->Thread = std::thread([p, renderer, film, scene, sceneView, samples] {
-        try
-        {
-          p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
-        }
-        catch (const std::exception& e)
-        {
-          p->Error = e.what();
-        }
-        p->Done = true;
-      });
-      in.InFlight = std::move(pass);
-      this->DrawFilm(ren, vol, *in.Shown);
-      return;
-    }
-    if (samples > 0)
-      in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
-    if (this->AsynchronousRefinement)
-      in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
+    for (const auto& [label, json] : in.LabelMaterialParameters)
+      mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
   }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro("Render: " << e.what());
+  in.Built.Property = now.Property;
+  in.Built.PropertyTime = now.PropertyTime;
+  in.Built.LabelParametersTime = now.LabelParametersTime;
+  ++in.Refits;
+}
+
+void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now)
+{
+  // A restart: a new film under the current camera, lights and settings.
+  Internals& in = *this->Internal;
+  vol->GetMatrix(in.Matrix);
+  const mmrtm::Affine3 propMatrix = ToAffine(in.Matrix);
+  for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
+    in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
+  mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
+  const int width = now.Width, height = now.Height;
+  // Camera rays stop at opaque geometry: it hides the volume behind it,
+  // and the volume in front of it hides it.
+  in.Scene.cameraRayMaxDistance =
+    now.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, now.Depth, width, height);
+  if (!in.LightsFromScene)
+    mmrtm::SetLightsFromVtk(ren, now.Property, in.Scene);
+  if (in.Environment)
+    in.Scene.environment = in.Environment;
+  in.Scene.clipPlanes = now.Clip;
+  mmrtm::RenderSettings& rs = in.Scene.render;
+  rs.width = width;
+  rs.height = height;
+  rs.threads = this->NumberOfThreads;
+  rs.exposure = static_cast<float>(this->Exposure);
+  rs.integrator.seed = static_cast<uint64_t>(this->Seed);
+  rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
+  rs.integrator.maxBounces = this->MaximumBounces;
+  rs.integrator.sampler =
+    this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
+  rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
+    : this->Accelerator == NO_ACCELERATOR             ? mmrtm::MajorantKind::Global
+                                                      : mmrtm::MajorantKind::Octree;
+  rs.integrator.backgroundVisible = false;  // VTK's background shows through
+  in.Film = std::make_unique<mmrtm::Film>(width, height);
+  in.Built.View = std::move(now.View);
+  in.Built.Clip = std::move(now.Clip);
+  in.Built.Depth = std::move(now.Depth);
+  in.Built.TracingTime = now.TracingTime;
+  in.HasScene = true;
+  ++in.Restarts;
+}
+
+void vtkMultiMaterialVolumeMapper::UpdateRenderer()
+{
+  Internals& in = *this->Internal;
+  if (in.Renderer && in.RendererBackend == this->Backend && in.RendererThreads == this->NumberOfThreads)
     return;
-  }
+  const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
+    : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
+                                                      : mmrtm::Backend::Auto;
+  in.Renderer = mmrtm::MakeRenderer(
+    backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); });
+  in.RendererBackend = this->Backend;
+  in.RendererThreads = this->NumberOfThreads;
+  in.BackendDescription = in.Renderer->Description();
+}
 
-  this->DrawFilm(ren, vol, *in.Film);
+const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
+{
+  // The scene's build refits only when what a refit reads changed, so a
+  // render after a camera move keeps the majorants and takes microseconds.
+  Internals& in = *this->Internal;
+  const auto buildStart = std::chrono::steady_clock::now();
+  const mmrtm::SceneView sceneView = in.Scene.Build();
+  in.CountGridWork();
+  if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning)  // once per change, not per render
+  {
+    in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
+    if (!in.LastExtinctionWarning.empty())
+      vtkWarningMacro(<< in.LastExtinctionWarning);
+  }
+  if (restart && (in.Scene.GridRefittedByLastBuild() || !in.Scene.Grid()))
+    in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
+  const int accumulated = static_cast<int>(in.Film->Samples());
+  const int samples = this->IsConverged() ? 0
+    : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
+                                          : this->SamplesPerRender;
+  if (samples > 0 && this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown)
+  {
+    // The next pass on a thread of its own, under in.Built; this render
+    // draws the last finished image.
+    auto pass = std::make_unique<Internals::Pass>();
+    Internals::Pass* p = pass.get();
+    mmrtm::Renderer* renderer = in.Renderer.get();
+    mmrtm::Film* film = in.Film.get();
+    const mmrtm::Scene* scene = &in.Scene;
+    p->Thread = std::thread([p, renderer, film, scene, sceneView, samples] {
+      try
+      {
+        p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
+      }
+      catch (const std::exception& e)
+      {
+        p->Error = e.what();
+      }
+      p->Done = true;
+    });
+    in.InFlight = std::move(pass);
+    return in.Shown.get();
+  }
+  if (samples > 0)
+    in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
+  if (this->AsynchronousRefinement)
+    in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
+  return in.Film.get();
 }
 
 // The proxies of the input (its components as the property uses them), the
@@ -937,7 +1004,6 @@ void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
   in.LightsFromScene = doc.contains("lights");
   in.Scene = mmrtm::SceneFromJson(doc, std::move(inputs));
   in.Layout = mmrtm::ProxyLayout();
-  in.PropertyTime = 0;
   ++in.Refits;
 }
 
@@ -1012,11 +1078,11 @@ std::vector<mmrtm::ClipPlane> vtkMultiMaterialVolumeMapper::ClipPlanes(vtkVolume
         planes.push_back(p);
       }
   }
-  if (static_cast<int>(planes.size()) > mmrtm::kMaxClipPlanes)
-  {
+  const bool tooMany = static_cast<int>(planes.size()) > mmrtm::kMaxClipPlanes;
+  if (this->Internal->Warn("clipping planes", tooMany))
     vtkWarningMacro("only " << mmrtm::kMaxClipPlanes << " clipping and cropping planes are used");
+  if (tooMany)
     planes.resize(mmrtm::kMaxClipPlanes);
-  }
   return planes;
 }
 
@@ -1029,7 +1095,8 @@ void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, in
   rs.width = w;
   rs.height = h;
   // The depth buffer at the preview's pixel centres.
-  if (!in.Depth.empty())
+  const std::vector<float>& fullDepth = in.Built.Depth;
+  if (!fullDepth.empty())
   {
     std::vector<float> depth(static_cast<size_t>(w) * h);
     for (int row = 0; row < h; ++row)
@@ -1037,7 +1104,7 @@ void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, in
       {
         const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / w));
         const int fy = std::min(height - 1, static_cast<int>((row + 0.5) * height / h));
-        depth[static_cast<size_t>(row) * w + x] = in.Depth[static_cast<size_t>(fy) * width + fx];
+        depth[static_cast<size_t>(row) * w + x] = fullDepth[static_cast<size_t>(fy) * width + fx];
       }
     in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, depth, w, h);
   }

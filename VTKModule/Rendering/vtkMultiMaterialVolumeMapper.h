@@ -395,6 +395,18 @@ protected:
 
 private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
+  struct InputState;
+  struct Changes;
+  // The phases of Render, in order.
+  bool ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4]);
+  InputState ReadInputs(vtkRenderer* ren, vtkVolume* vol, const int viewport[4]);
+  Changes ChangesSince(const InputState& built, const InputState& now);
+  void UpdateProxies(const InputState& now);
+  void UpdateDescription(const InputState& now);
+  void UpdateMaterials(const InputState& now);
+  void UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now);
+  void UpdateRenderer();
+  const mmrtm::Film* Refine(bool restart);
   void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
