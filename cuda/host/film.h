@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "image_io.h"
-#include "mmrtm/film.h"
+#include "mmrtm/film_view.h"
 #include "mmrtm/tonemap.h"
 
 namespace mmrtm {

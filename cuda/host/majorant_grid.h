@@ -45,7 +45,7 @@
 #include "host_volume.h"
 #include "leaf_summary_table.h"
 #include "mmrtm/classifier.h"
-#include "mmrtm/majorant_grid.h"
+#include "mmrtm/majorant_grid_view.h"
 #include "mmrtm/majorant_refit.h"
 
 namespace mmrtm {

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "mmrtm/defs.h"
-#include "mmrtm/majorant_grid.h"
+#include "mmrtm/majorant_grid_view.h"
 #include "mmrtm/ray.h"
 
 namespace mmrtm {

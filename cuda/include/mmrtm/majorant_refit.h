@@ -15,7 +15,7 @@
 #pragma once
 
 #include "mmrtm/classifier.h"
-#include "mmrtm/majorant_grid.h"
+#include "mmrtm/majorant_grid_view.h"
 #include "mmrtm/planted_defect.h"
 
 namespace mmrtm {
