@@ -70,9 +70,11 @@ std::array<double, 6> WorldBounds(vtkImageData* image) {
   return b;
 }
 
+// How labels look when the description does not say: as the ct-organs
+// preset has them (vessels and bones by name, any other label at full
+// opacity in its table colour).
 json DefaultLabelMaterials() {
-  return json::parse(R"({"proxy": "labels", "classes": [{"match": ["*"], "color": "table",
-    "material": {"density": 2.5, "roughness": 0.45, "surface_probability": 0.75, "anisotropy": 0.2}}]})");
+  return ReadJsonFile(PresetPath(vtkMultiMaterialProperty::GetPresetDirectory(), "ct-organs")).at("label_materials");
 }
 
 json DefaultLights() {
@@ -86,6 +88,16 @@ json* FindScalarCCTF(json& tfs) {
   for (json& tf : tfs)
     if (tf.value("type", "") == "cctf" && tf.value("proxy", "scalars") == "scalars") return &tf;
   return nullptr;
+}
+
+// A row of the label list as the one label rule takes it.
+LabelLook Look(const LabelEntry& l) {
+  LabelLook look;
+  look.color = {l.color.redF(), l.color.greenF(), l.color.blueF()};
+  look.opacity = std::clamp(l.opacity, 0.0, 1.0);
+  look.visible = l.visible;
+  look.surface = {{"surface_probability", l.surfaceProbability}, {"roughness", l.roughness}};
+  return look;
 }
 
 const char* const kAcceleratorNames[] = {"octree", "macrocell", "none"};
@@ -211,7 +223,7 @@ void ViewerScene::RefreshLabelEntries() {
                                    std::clamp(albedo[2].get<double>(), 0.0, 1.0));
         l.surfaceProbability = m.value("surface_probability", 0.0);
         l.roughness = m.value("roughness", 0.5);
-        l.opacity = std::min(1.0, m.value("density", 1.0) / kLabelDensity);
+        l.opacity = LabelOpacity(m.value("density", 1.0));
       }
   }
 }
@@ -512,14 +524,9 @@ json ViewerScene::Description() const {
     for (int id : editedLabels_)
       for (const LabelEntry& l : labels_)
         if (l.id == id)
-          classes.insert(classes.begin(),
-                         json::object({{"ids", json::array({id})},
-                                       {"color", "material"},
-                                       {"material", json::object({{"density", l.visible ? kLabelDensity * l.opacity : 0.0},
-                                                                  {"albedo", json::array({l.color.redF(), l.color.greenF(),
-                                                                                          l.color.blueF()})},
-                                                                  {"surface_probability", l.surfaceProbability},
-                                                                  {"roughness", l.roughness}})}}));
+          classes.insert(classes.begin(), json::object({{"ids", json::array({id})},
+                                                        {"color", "material"},
+                                                        {"material", LabelMaterial(Look(l))}}));
     if (!labelTablePath_.empty()) doc["label_table"] = labelTablePath_;
   } else {
     doc.erase("label_materials");

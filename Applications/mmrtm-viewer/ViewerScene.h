@@ -93,10 +93,6 @@ class ViewerScene {
   nlohmann::json Description() const;
   void Apply();
 
-  // The density a label's material has at opacity 1 (the ct-organs preset's
-  // organs, per mm).
-  static constexpr double kLabelDensity = 2.5;
-
  private:
   void AdoptVolume(vtkImageData* image, const std::string& path, const std::string& series);
   static QVector<LabelEntry> LabelsPresent(vtkImageData* labels, vtkImageData* volume, const std::string& path);

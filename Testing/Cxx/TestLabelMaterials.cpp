@@ -129,5 +129,62 @@ TEST(LabelMaterials, IdsPresentInAVolume) {
   EXPECT_THROW(LabelIdsPresent(v), InputError);
 }
 
+// The one label rule (Slicer's segments, the viewer's label list): density
+// 2.5/mm times the opacity, none when hidden, the colour as albedo, the
+// surface parameters kept. Catches another density rule or an opacity that
+// does not come back through LabelOpacity.
+TEST(LabelMaterials, ALabelsLookIsOneMaterial) {
+  LabelLook look;
+  look.color = {0.8, 0.2, 0.1};
+  look.opacity = 0.4;
+  look.surface = {{"roughness", 0.3}, {"surface_probability", 0.75}};
+  const json m = LabelMaterial(look);
+  EXPECT_DOUBLE_EQ(m["density"].get<double>(), 0.4 * kLabelDensityAtFullOpacity);
+  EXPECT_EQ(m["albedo"], json::array({0.8, 0.2, 0.1}));
+  EXPECT_EQ(m["roughness"], 0.3);
+  EXPECT_EQ(m["surface_probability"], 0.75);
+  EXPECT_DOUBLE_EQ(LabelOpacity(m["density"].get<double>()), 0.4);
+  EXPECT_DOUBLE_EQ(LabelOpacity(10.0), 1.0);
+  look.visible = false;
+  EXPECT_EQ(LabelMaterial(look)["density"], 0.0);
+  // Through the scene format: the label's material is this one.
+  look.visible = true;
+  const json doc = {{"label_materials",
+                     {{"classes", json::array({{{"ids", {7}}, {"color", "material"}, {"material", LabelMaterial(look)}}})}}}};
+  const json expanded = ExpandLabelMaterials(doc, {7}, nullptr);
+  EXPECT_DOUBLE_EQ(expanded["materials"]["label_7"]["density"].get<double>(), 0.4 * kLabelDensityAtFullOpacity);
+  EXPECT_EQ(expanded["materials"]["label_7"]["albedo"], json::array({0.8, 0.2, 0.1}));
+}
+
+TEST(LabelMaterials, ALabelsLookOutOfRangeIsAnErrorNamingIt) {
+  LabelLook look;
+  look.opacity = 1.5;
+  try {
+    LabelMaterial(look);
+    FAIL() << "an opacity of 1.5 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("opacity"), std::string::npos) << e.what();
+  }
+  look.opacity = 1.0;
+  look.surface = {{"shininess", 3}};
+  try {
+    LabelMaterial(look);
+    FAIL() << "an unknown key was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("shininess"), std::string::npos) << e.what();
+  }
+}
+
+// The presets and the rule agree: ct-organs' class for any other label is
+// a label at opacity 1. Catches a preset or a rule changed alone.
+TEST(LabelMaterials, TheOrgansPresetsOtherLabelsAreAtFullOpacity) {
+  std::ifstream in(std::string(MMRTM_DATA_DIR) + "/presets/ct-organs.json");
+  ASSERT_TRUE(in) << MMRTM_DATA_DIR << "/presets/ct-organs.json";
+  const json preset = json::parse(in);
+  const json& last = preset["label_materials"]["classes"].back();
+  ASSERT_EQ(last["match"], json::array({"*"}));
+  EXPECT_DOUBLE_EQ(last["material"]["density"].get<double>(), kLabelDensityAtFullOpacity);
+}
+
 }  // namespace
 }  // namespace mmrtm

@@ -36,6 +36,7 @@
 #include "derived_proxies.h"
 #include "film.h"
 #include "label_alignment.h"
+#include "label_materials.h"
 #include "mmrtmImageDataConversion.h"
 #include "mmrtmVolumePropertyFunctions.h"
 #include "mmrtmVtkSceneTranslation.h"
@@ -540,6 +541,11 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfInteractiveRenders()
 int vtkMultiMaterialVolumeMapper::GetNumberOfRestarts()
 {
   return this->Internal->Restarts;
+}
+
+double vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity()
+{
+  return mmrtm::kLabelDensityAtFullOpacity;
 }
 
 const char* vtkMultiMaterialVolumeMapper::GetBackendDescription()

@@ -357,6 +357,14 @@ public:
   double GetLastRefitSeconds();
 
   /**
+   * The extinction per millimetre of a label shown at opacity 1 (2.5: as
+   * opaque as the organs of the ct-organs preset): the one density rule by
+   * which front ends turn a label's opacity into a material (Slicer's
+   * segments, the viewer's label list).
+   */
+  static double GetLabelDensityAtFullOpacity();
+
+  /**
    * Description of the backend in use ("cpu, 2 thread(s)"), after a render.
    */
   const char* GetBackendDescription();

@@ -140,4 +140,26 @@ json ExpandLabelMaterials(json doc, const std::vector<int>& ids, const LabelTabl
   return doc;
 }
 
+json LabelMaterial(const LabelLook& look) {
+  const std::string where = "label material";
+  if (!(look.opacity >= 0.0 && look.opacity <= 1.0))
+    Fail(where + ".opacity", "expected a number in [0, 1], got " + std::to_string(look.opacity));
+  for (double c : look.color)
+    if (!(c >= 0.0 && c <= 1.0)) Fail(where + ".color", "expected three numbers in [0, 1]");
+  if (!look.surface.is_object()) Fail(where, "the surface parameters must be a JSON object");
+  json m = json::object();
+  m["density"] = look.visible ? kLabelDensityAtFullOpacity * look.opacity : 0.0;
+  m["albedo"] = json::array({look.color[0], look.color[1], look.color[2]});
+  static const std::set<std::string> known = {"roughness", "metallic", "surface_probability", "anisotropy",
+                                              "emission"};
+  for (const auto& [key, value] : look.surface.items()) {
+    if (!known.count(key))
+      Fail(where, "unknown key '" + key + "' (roughness, metallic, surface_probability, anisotropy, emission)");
+    m[key] = value;
+  }
+  return m;
+}
+
+double LabelOpacity(double density) { return std::clamp(density / kLabelDensityAtFullOpacity, 0.0, 1.0); }
+
 }  // namespace mmrtm

@@ -4,6 +4,7 @@
 // the label proxy. Host-only set-up code (a JSON transformation).
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,32 @@
 #include "label_table.h"
 
 namespace mmrtm {
+
+// One label as a front end shows it (a segment in Slicer, a row of the
+// viewer's label list): its colour, its opacity in [0, 1], whether it is
+// shown, and optional surface and phase parameters ("roughness",
+// "metallic", "surface_probability", "anisotropy", "emission").
+struct LabelLook {
+  std::array<double, 3> color{1.0, 1.0, 1.0};
+  double opacity = 1.0;
+  bool visible = true;
+  nlohmann::json surface = nlohmann::json::object();
+};
+
+// The extinction, per millimetre, of a label at opacity 1: as opaque as the
+// organs of the ct-organs preset. The one density rule for labels.
+constexpr double kLabelDensityAtFullOpacity = 2.5;
+
+// The material of a label (an entry of a scene's "materials"): density
+// kLabelDensityAtFullOpacity times the opacity (0 when hidden: the label
+// holds nothing), albedo its colour, and its surface parameters. Throws
+// InputError naming the key for an unknown parameter or an opacity or
+// colour outside [0, 1].
+nlohmann::json LabelMaterial(const LabelLook& look);
+
+// The opacity whose label material has this density (LabelMaterial's
+// inverse), clamped to [0, 1].
+double LabelOpacity(double density);
 
 // The distinct non-zero values of a label map, ascending. Throws InputError
 // naming the volume for a non-integer value.

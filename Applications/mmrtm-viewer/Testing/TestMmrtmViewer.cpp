@@ -170,13 +170,25 @@ class TestMmrtmViewer : public QObject {
     QVERIFY(liver >= 0);
     mmrtm::viewer::LabelEntry entry = table->labels()[liver];
     entry.color = QColor(0, 0, 255);
+    entry.opacity = 0.8;
     table->setLabel(liver, entry);
+    // The edited label's material by the one label rule: density 2.5/mm
+    // times its opacity, its colour as albedo (Slicer's segments too).
+    auto labelMaterial = [&] {
+      const nlohmann::json description = v.window.scene().Description();
+      for (const nlohmann::json& c : description["label_materials"]["classes"])
+        if (c.value("ids", nlohmann::json::array()) == nlohmann::json::array({entry.id})) return c["material"];
+      return nlohmann::json();
+    };
+    QCOMPARE(labelMaterial()["density"].get<double>(), 0.8 * vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity());
+    QCOMPARE(labelMaterial()["albedo"], nlohmann::json::array({0.0, 0.0, 1.0}));
     QVERIFY(RefineTo(v.window, 8));
     const QImage before = View(v.window);
     vtkMultiMaterialVolumeMapper* m = v.window.scene().Mapper();
     const int restarts = m->GetNumberOfRestarts();
     entry.visible = false;
     table->setLabel(liver, entry);
+    QCOMPARE(labelMaterial()["density"].get<double>(), 0.0);
     // The edit reaches the mapper at its next render, which may wait for a
     // pass in flight: until it restarts, the count of 8 is the old image's.
     QVERIFY2(QTest::qWaitFor([&] { return m->GetNumberOfRestarts() > restarts; }, 120000), "hiding restarts");

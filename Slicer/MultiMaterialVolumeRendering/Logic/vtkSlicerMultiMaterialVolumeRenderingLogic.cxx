@@ -216,6 +216,11 @@ bool vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(
   return true;
 }
 
+double vtkSlicerMultiMaterialVolumeRenderingLogic::GetSegmentExtinctionAtFullOpacity()
+{
+  return vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity();
+}
+
 double vtkSlicerMultiMaterialVolumeRenderingLogic::SegmentOpacityToScalarOpacity(
   double opacity3D, double unitDistance)
 {

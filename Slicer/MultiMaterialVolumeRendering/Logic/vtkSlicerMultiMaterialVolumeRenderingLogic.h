@@ -97,8 +97,9 @@ public:
   /// ScalarOpacityUnitDistance, mm) for its 3D opacity: the extinction is
   /// GetSegmentExtinctionAtFullOpacity() times the 3D opacity.
   static double SegmentOpacityToScalarOpacity(double opacity3D, double unitDistance);
-  /// 2.5 per mm: as opaque as the organs of the ct-organs preset.
-  static double GetSegmentExtinctionAtFullOpacity() { return 2.5; }
+  /// The mapper's label rule (vtkMultiMaterialVolumeMapper::
+  /// GetLabelDensityAtFullOpacity, 2.5 per mm): the viewer's too.
+  static double GetSegmentExtinctionAtFullOpacity();
 
 protected:
   vtkSlicerMultiMaterialVolumeRenderingLogic();
