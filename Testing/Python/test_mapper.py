@@ -6,6 +6,7 @@ mapper redoes exactly the work that change needs (counted by the mapper).
 Run by ctest under Testing/headless.sh (its own Xvfb) with /usr/bin/python3 (python3-vtk9) and the
 build tree's mmrtm package on PYTHONPATH.
 """
+import math
 import os
 import subprocess
 import sys
@@ -499,6 +500,53 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(grey.GetMTime(), before)
         self.assertGreater(coverage(s.pixels()), 0.05, "the head was rendered with the default colour")
+
+    def test_a_label_material_is_the_label_functions_of_its_look(self):
+        """SetLabelMaterial (the one label rule: density 2.5/mm x opacity, the
+        colour as albedo) renders as VTK label functions of that look do:
+        a constant colour and the opacity 1 - exp(-2.5 o d) per unit distance
+        d, which the mapper turns back into 2.5 o. The materials differ in
+        form (a constant against a curve), so their majorants and random
+        numbers may differ: the images' mean brightness is compared, with
+        its standard error from 6 seeds of each (limit |z| < 4.5). Power: a
+        look 20 % fainter (opacity 0.08 instead of 0.1) gives z = 6.6 here,
+        and the test requires it to fail.
+        """
+        colour, opacity = (0.2, 0.4, 0.9), 0.1  # translucent: the opacity shows
+
+        def brightness(seed, look_opacity=None):
+            s = Scene()
+            s.mapper.SetSeed(seed)
+            s.add_bone_labels(colour)
+            if look_opacity is None:
+                unit = s.property.GetScalarOpacityUnitDistance()
+                a = 1.0 - math.exp(-vtkMultiMaterialVolumeMapper.GetLabelDensityAtFullOpacity() * opacity * unit)
+                f = vtkPiecewiseFunction()
+                f.AddPoint(0, a)
+                s.property.SetLabelScalarOpacity(1, f)
+            else:
+                s.mapper.SetLabelMaterial(1, *colour, look_opacity)
+            for _ in range(4):
+                s.render()
+            pixels = s.pixels()
+            self.assertGreater(coverage(pixels), 0.05, "the bone label shows")
+            return sum(pixels) / len(pixels)
+
+        def z(a, b):
+            def mean_var(x):
+                m = sum(x) / len(x)
+                return m, sum((v - m) ** 2 for v in x) / (len(x) - 1) / len(x)
+            (ma, va), (mb, vb) = mean_var(a), mean_var(b)
+            return (mb - ma) / math.sqrt(va + vb)
+
+        seeds = range(10, 16)
+        functions = [brightness(seed) for seed in seeds]
+        look = [brightness(seed, opacity) for seed in seeds]
+        fainter = [brightness(seed, 0.08) for seed in seeds]
+        print("label functions %.3f, label material %.3f (z %.2f), at opacity 0.08 %.3f (z %.2f)" % (
+            sum(functions) / 6, sum(look) / 6, z(functions, look), sum(fainter) / 6, z(functions, fainter)))
+        self.assertLess(abs(z(functions, look)), 4.5)
+        self.assertGreater(abs(z(functions, fainter)), 4.5, "the check sees the lower opacity")
 
     def test_each_warning_once_for_its_own_cause(self):
         """Each of the mapper's warnings is said once when its cause appears,

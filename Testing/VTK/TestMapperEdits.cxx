@@ -427,6 +427,23 @@ std::vector<Case> Cases()
     },
     [](Objects& o) { o.mapper->RemoveAllLabelMaterialParameters(); } });
   c.push_back({ "mask-binary", Input::HeadLabels, labelled, [](Objects& o) { o.mapper->SetMaskTypeToBinary(); } });
+  // Labels by the one label rule (SetLabelMaterial: how Slicer's segments come).
+  const auto looks = [](Objects& o) {
+    Labelled(o, false);
+    o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.6);
+  };
+  c.push_back({ "label-look-added", Input::HeadLabels, looks,
+    [](Objects& o) { o.mapper->SetLabelMaterial(2, 0.1, 0.3, 0.9, 1.0); } });
+  c.push_back({ "label-look-colour", Input::HeadLabels, looks,
+    [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.1, 0.9, 0.2, 0.6); } });
+  c.push_back({ "label-look-opacity", Input::HeadLabels, looks,
+    [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.2); } });
+  c.push_back({ "label-look-over-functions", Input::HeadLabels, labelled,
+    [](Objects& o) { o.mapper->SetLabelMaterial(2, 0.9, 0.9, 0.1, 1.0); } });
+  c.push_back({ "label-look-removed", Input::HeadLabels, looks,
+    [](Objects& o) { o.mapper->RemoveLabelMaterial(1); } });
+  c.push_back({ "label-look-same-values", Input::HeadLabels, looks,
+    [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.6); }, false, Work::Display });
 
   // The mapper's own settings.
   c.push_back({ "seed", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetSeed(kSeed + 1); } });

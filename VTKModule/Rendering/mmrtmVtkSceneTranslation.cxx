@@ -394,6 +394,41 @@ int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const P
   return nodes + ReplaceNonFinite(scene);
 }
 
+void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
+                  const ProxyLayout& proxies, Scene& scene) {
+  if (proxies.labels < 0) return;
+  const nlohmann::json rule = LabelMaterial(look);
+  MaterialDesc m;
+  m.name = "label " + std::to_string(label);
+  m.base[QuantityOffset(Quantity::Density)] = rule["density"].get<float>();
+  for (int c = 0; c < 3; ++c) m.base[QuantityOffset(Quantity::Albedo) + c] = rule["albedo"][c].get<float>();
+  ApplyShading(property, component, m);
+  if (const int index = scene.MaterialIndex(m.name); index >= 0) {
+    scene.materials[index] = std::move(m);  // the property's label functions made it: the selector has it
+    return;
+  }
+  // The label selector (SetMaterialsFromProperty puts it first), made when
+  // the property has no label functions.
+  TransferFunctionDesc* selector = nullptr;
+  for (int i : scene.selectors)
+    if (scene.tfs[i].where == "label map") selector = &scene.tfs[i];
+  if (!selector) {
+    TransferFunctionDesc tf;
+    tf.where = "label map";
+    tf.type = TFType::MDPTF;
+    tf.proxy = proxies.labels;
+    tf.channels = 1;
+    scene.tfs.push_back(std::move(tf));
+    scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1);
+    selector = &scene.tfs.back();
+  }
+  const auto at = std::lower_bound(selector->keys.begin(), selector->keys.end(), (float)label);
+  const auto offset = at - selector->keys.begin();
+  selector->keys.insert(at, (float)label);
+  selector->materials.insert(selector->materials.begin() + offset, (int)scene.materials.size());
+  scene.materials.push_back(std::move(m));
+}
+
 void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene) {
   const std::string where = "label " + std::to_string(label) + " material";
   const nlohmann::json doc = ParseJson(json, where);

@@ -36,6 +36,7 @@
 #include <array>
 #include <string>
 
+#include "label_materials.h"
 #include "scene.h"
 
 class vtkCamera;
@@ -90,6 +91,14 @@ struct ProxyLayout {
 // weight) is 0; returns how many there were, for the caller to warn about.
 // (A NaN unit distance is VTK's default 1, without a warning.)
 int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
+
+// Gives label `label` the material of `look` by the one label rule
+// (LabelMaterial: density and albedo), shaded as the property's component
+// `component` is, without gradient opacity: in place of the material that
+// the property's label functions made, else added to the label selector.
+// Throws InputError for a look out of range.
+void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
+                  const ProxyLayout& proxies, Scene& scene);
 
 // Gives label `label`'s material (made by SetMaterialsFromProperty) the
 // surface and phase parameters VTK's label functions cannot say: a JSON

@@ -114,9 +114,16 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::shared_ptr<mmrtm::EnvironmentMap> Environment;  // converted from the texture
   vtkMTimeType EnvironmentTime = 0;
   double EnvironmentScale = 0;
-  // SetLabelMaterialParameters, by label, and when they last changed.
+  // SetLabelMaterial and SetLabelMaterialParameters, by label, and when
+  // either last changed.
+  std::map<int, mmrtm::LabelLook> LabelLooks;
   std::map<int, std::string> LabelMaterialParameters;
-  vtkTimeStamp LabelMaterialParametersTime;
+  vtkTimeStamp LabelMaterialsTime;
+  void LabelMaterialsModified(vtkMultiMaterialVolumeMapper* mapper)
+  {
+    this->LabelMaterialsTime.Modified();
+    mapper->Modified();
+  }
   // The inputs as the scene and the film were last made from them; each
   // render compares what it finds with these (ChangesSince).
   InputState Built;
@@ -428,6 +435,44 @@ int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
   return film ? static_cast<int>(film->Samples()) : 0;
 }
 
+void vtkMultiMaterialVolumeMapper::SetLabelMaterial(int label, double r, double g, double b, double opacity)
+{
+  mmrtm::LabelLook look;
+  look.color = { r, g, b };
+  look.opacity = opacity;
+  auto& looks = this->Internal->LabelLooks;
+  const auto found = looks.find(label);
+  if (found != looks.end() && found->second.color == look.color && found->second.opacity == opacity)
+    return;
+  looks[label] = look;
+  this->Internal->LabelMaterialsModified(this);
+}
+
+bool vtkMultiMaterialVolumeMapper::GetLabelMaterial(int label, double rgbo[4])
+{
+  const auto found = this->Internal->LabelLooks.find(label);
+  if (found == this->Internal->LabelLooks.end())
+    return false;
+  for (int c = 0; c < 3; ++c)
+    rgbo[c] = found->second.color[c];
+  rgbo[3] = found->second.opacity;
+  return true;
+}
+
+void vtkMultiMaterialVolumeMapper::RemoveLabelMaterial(int label)
+{
+  if (this->Internal->LabelLooks.erase(label))
+    this->Internal->LabelMaterialsModified(this);
+}
+
+void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterials()
+{
+  if (this->Internal->LabelLooks.empty())
+    return;
+  this->Internal->LabelLooks.clear();
+  this->Internal->LabelMaterialsModified(this);
+}
+
 void vtkMultiMaterialVolumeMapper::SetLabelMaterialParameters(int label, const char* json)
 {
   auto& parameters = this->Internal->LabelMaterialParameters;
@@ -444,8 +489,7 @@ void vtkMultiMaterialVolumeMapper::SetLabelMaterialParameters(int label, const c
       return;
     parameters[label] = json;
   }
-  this->Internal->LabelMaterialParametersTime.Modified();
-  this->Modified();
+  this->Internal->LabelMaterialsModified(this);
 }
 
 const char* vtkMultiMaterialVolumeMapper::GetLabelMaterialParameters(int label)
@@ -459,8 +503,7 @@ void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterialParameters()
   if (this->Internal->LabelMaterialParameters.empty())
     return;
   this->Internal->LabelMaterialParameters.clear();
-  this->Internal->LabelMaterialParametersTime.Modified();
-  this->Modified();
+  this->Internal->LabelMaterialsModified(this);
 }
 
 double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
@@ -668,7 +711,7 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   now.Property = property;
   now.PropertyTime = PropertyMTime(property);
   now.MultiMaterialTime = in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0;
-  now.LabelParametersTime = in.LabelMaterialParametersTime.GetMTime();
+  now.LabelParametersTime = in.LabelMaterialsTime.GetMTime();
 
   // Camera, lights, matrix, viewport (by value), clipping, the environment,
   // the opaque geometry (its depth), and the mapper's own settings.
@@ -748,6 +791,8 @@ void vtkMultiMaterialVolumeMapper::UpdateMaterials(const InputState& now)
                        "weight); they were read as 0");
   if (in.Layout.labels >= 0)
   {
+    for (const auto& [label, look] : in.LabelLooks)
+      mmrtm::SetLabelLook(label, look, now.Property, 0, in.Layout, in.Scene);
     for (const auto& [label, json] : in.LabelMaterialParameters)
       mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
   }

@@ -239,9 +239,28 @@ public:
 
   ///@{
   /**
+   * With a LABELMAP mask: label `label` shown as a material by the one
+   * label rule (GetLabelDensityAtFullOpacity): its colour (0 to 1) the
+   * albedo, its opacity (0 to 1) times 2.5 per mm the extinction, no
+   * gradient opacity, shading from the volume property, surface parameters
+   * from SetLabelMaterialParameters. It takes the place of the property's
+   * label functions for that label; a label without one keeps them (or,
+   * without those, shows the property's own functions). Setting the same
+   * values again changes nothing. Values outside [0, 1] are an error at
+   * the next render. 3D Slicer's segments reach the mapper this way.
+   */
+  void SetLabelMaterial(int label, double r, double g, double b, double opacity);
+  // The label's colour and opacity in rgbo; false (rgbo untouched) without one.
+  bool GetLabelMaterial(int label, double rgbo[4]);
+  void RemoveLabelMaterial(int label);
+  void RemoveAllLabelMaterials();
+  ///@}
+
+  ///@{
+  /**
    * With a LABELMAP mask: surface and phase parameters of label `label`'s
    * material, which VTK's label functions cannot say (its colour, opacity
-   * and gradient opacity stay the property's). `json` is an object with
+   * and gradient opacity stay the property's or SetLabelMaterial's). `json` is an object with
    * any of "roughness", "metallic", "surface_probability" (0 to 1),
    * "anisotropy" (-1 to 1) and "emission" ([r, g, b]); an unknown key or a
    * value out of range is an error at the next render. A null or empty
