@@ -20,20 +20,17 @@
 #include <vtkMultiMaterialVolumeMapper.h>
 
 // VTK
-#include <vtkColorTransferFunction.h>
 #include <vtkImageData.h>
 #include <vtkIntArray.h>
 #include <vtkMatrix3x3.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
-#include <vtkPiecewiseFunction.h>
 #include <vtkPointData.h>
 #include <vtkStringArray.h>
 #include <vtkVolumeProperty.h>
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 #include <vector>
 
@@ -216,23 +213,11 @@ bool vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(
   return true;
 }
 
-double vtkSlicerMultiMaterialVolumeRenderingLogic::GetSegmentExtinctionAtFullOpacity()
-{
-  return vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity();
-}
-
-double vtkSlicerMultiMaterialVolumeRenderingLogic::SegmentOpacityToScalarOpacity(
-  double opacity3D, double unitDistance)
-{
-  const double extinction = GetSegmentExtinctionAtFullOpacity() * std::clamp(opacity3D, 0.0, 1.0);
-  return 1.0 - std::exp(-extinction * std::max(unitDistance, 1e-6));
-}
-
-int vtkSlicerMultiMaterialVolumeRenderingLogic::SetSegmentLabelFunctions(
-  vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkStringArray* segmentIds, vtkVolumeProperty* property)
+int vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(
+  vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkStringArray* segmentIds, vtkMultiMaterialVolumeMapper* mapper)
 {
   vtkMRMLSegmentationNode* segmentationNode = node ? node->GetSegmentationNode() : nullptr;
-  if (!segmentationNode || !segmentIds || !property)
+  if (!segmentationNode || !segmentIds || !mapper)
     return 0;
   auto* display = vtkMRMLSegmentationDisplayNode::SafeDownCast(segmentationNode->GetDisplayNode());
   vtkSegmentation* segmentation = segmentationNode->GetSegmentation();
@@ -240,26 +225,21 @@ int vtkSlicerMultiMaterialVolumeRenderingLogic::SetSegmentLabelFunctions(
   for (vtkIdType i = 0; i < segmentIds->GetNumberOfValues(); ++i)
   {
     const std::string id = segmentIds->GetValue(i);
+    const int label = static_cast<int>(i) + 1;
     vtkSegment* segment = segmentation->GetSegment(id);
     const bool shown = segment &&
       (!display || (display->GetSegmentVisibility(id) && display->GetSegmentVisibility3D(id)));
     if (!shown)
+    {
+      mapper->RemoveLabelMaterial(label);
       continue;
-    const int label = static_cast<int>(i) + 1;
+    }
     double rgb[3];
     segment->GetColor(rgb);
     if (display)
       display->GetSegmentColor(id, rgb);  // with the display node's override, if any
     const double opacity3D = display ? display->GetSegmentOpacity3D(id) : 1.0;
-    vtkNew<vtkColorTransferFunction> color;
-    color->AddRGBPoint(0.0, rgb[0], rgb[1], rgb[2]);
-    vtkNew<vtkPiecewiseFunction> opacity;
-    opacity->AddPoint(0.0, SegmentOpacityToScalarOpacity(opacity3D, property->GetScalarOpacityUnitDistance()));
-    vtkNew<vtkPiecewiseFunction> noGradientOpacity;  // segments are solid, whatever the volume's edges do
-    noGradientOpacity->AddPoint(0.0, 1.0);
-    property->SetLabelColor(label, color);
-    property->SetLabelScalarOpacity(label, opacity);
-    property->SetLabelGradientOpacity(label, noGradientOpacity);
+    mapper->SetLabelMaterial(label, rgb[0], rgb[1], rgb[2], std::clamp(opacity3D, 0.0, 1.0));
     ++visible;
   }
   return visible;

@@ -79,27 +79,20 @@ public:
   static bool ExportSegmentLabelMap(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
     vtkImageData* labelMap, vtkStringArray* segmentIds);
 
-  /// Label functions on `property` (a copy of the volume property, without
-  /// label functions of its own) for the segments of `segmentIds` (label
-  /// n + 1 for segment n): a visible segment (visible, and visible in 3D, in
-  /// the segmentation's display node) gets its colour, a constant opacity
-  /// from its 3D opacity (SegmentOpacityToScalarOpacity) and no gradient
-  /// opacity; a hidden one gets none, so that the volume property's own
-  /// functions show there. Returns the number of visible segments.
-  static int SetSegmentLabelFunctions(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
-    vtkStringArray* segmentIds, vtkVolumeProperty* property);
+  /// The segments of `segmentIds` as label materials of `mapper` (label
+  /// n + 1 for segment n) by the mapper's one label rule
+  /// (vtkMultiMaterialVolumeMapper::SetLabelMaterial): a visible segment
+  /// (visible, and visible in 3D, in the segmentation's display node) its
+  /// colour and 3D opacity; a hidden one none, so that the volume
+  /// property's own functions show there. Unchanged segments change
+  /// nothing in the mapper. Returns the number of visible segments.
+  static int ApplySegmentLooks(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkStringArray* segmentIds,
+    vtkMultiMaterialVolumeMapper* mapper);
 
   /// The node's segment material parameters on the mapper, by label.
   static void ApplySegmentMaterialParameters(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
     vtkStringArray* segmentIds, vtkMultiMaterialVolumeMapper* mapper);
 
-  /// A segment's label opacity per `unitDistance` (the property's
-  /// ScalarOpacityUnitDistance, mm) for its 3D opacity: the extinction is
-  /// GetSegmentExtinctionAtFullOpacity() times the 3D opacity.
-  static double SegmentOpacityToScalarOpacity(double opacity3D, double unitDistance);
-  /// The mapper's label rule (vtkMultiMaterialVolumeMapper::
-  /// GetLabelDensityAtFullOpacity, 2.5 per mm): the viewer's too.
-  static double GetSegmentExtinctionAtFullOpacity();
 
 protected:
   vtkSlicerMultiMaterialVolumeRenderingLogic();

@@ -64,8 +64,7 @@ struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
   // label functions (the node's own property stays as the user made it).
   vtkNew<vtkImageData> LabelMap;
   vtkNew<vtkStringArray> SegmentIds;
-  vtkSmartPointer<vtkVolumeProperty> SegmentProperty;
-  std::string LabelMapSignature, LabelFunctionSignature;
+  std::string LabelMapSignature;
   std::string MaterialDescription = "\n";  // preset and JSON last applied ("\n": none yet)
 
   std::vector<double> ClipPlanes;  // the planes last applied, by value
@@ -253,30 +252,6 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateGeometry()
 
 namespace
 {
-// What the label functions are made of: per segment its ID, colour,
-// visibility and 3D opacity, and the property's opacity unit distance.
-std::string LabelFunctionSignature(vtkMRMLSegmentationNode* segmentation, vtkStringArray* ids, double unitDistance)
-{
-  std::ostringstream s;
-  s.precision(17);
-  s << unitDistance;
-  auto* display = vtkMRMLSegmentationDisplayNode::SafeDownCast(segmentation->GetDisplayNode());
-  for (vtkIdType i = 0; i < ids->GetNumberOfValues(); ++i)
-  {
-    const std::string id = ids->GetValue(i);
-    double rgb[3] = { 0, 0, 0 };
-    if (vtkSegment* segment = segmentation->GetSegmentation()->GetSegment(id))
-      segment->GetColor(rgb);
-    if (display)
-      display->GetSegmentColor(id, rgb);
-    s << ';' << id << ',' << rgb[0] << ',' << rgb[1] << ',' << rgb[2];
-    if (display)
-      s << ',' << display->GetSegmentVisibility(id) << display->GetSegmentVisibility3D(id) << ','
-        << display->GetSegmentOpacity3D(id);
-  }
-  return s.str();
-}
-
 // What the label map is made of: the segments, their order and their
 // binary labelmaps, the volume's grid and both nodes' transforms.
 std::string LabelMapSignature(vtkMRMLSegmentationNode* segmentation, vtkMRMLVolumeNode* volume)
@@ -305,8 +280,8 @@ std::string LabelMapSignature(vtkMRMLSegmentationNode* segmentation, vtkMRMLVolu
 }
 }
 
-// The property the mapper translates: the volume property node's own, or
-// with a segmentation a copy of it with the segments as label functions;
+// The volume property node's property, as it is (rendering never changes
+// it); with a segmentation, its segments as the mapper's label materials;
 // then the material preset and the segments' material parameters.
 void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
 {
@@ -323,42 +298,25 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
       vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(node, in.LabelMap, in.SegmentIds);
       in.LabelMap->Modified();
       in.LabelMapSignature = mapSignature;
-      in.LabelFunctionSignature.clear();
+      in.Mapper->RemoveAllLabelMaterials();  // the labels are numbered anew
     }
     labels = in.SegmentIds->GetNumberOfValues() > 0;
   }
+  if (in.Volume->GetProperty() != property)
+    in.Volume->SetProperty(property);
   if (labels)
   {
-    // The copy is made again when the property or a segment's look changed.
-    std::ostringstream signature;
-    signature << property << '@' << property->GetMTime();
-    for (vtkObject* f : { static_cast<vtkObject*>(property->GetScalarOpacity()),
-           static_cast<vtkObject*>(property->GetRGBTransferFunction()),
-           static_cast<vtkObject*>(property->GetGradientOpacity()) })
-      signature << ',' << (f ? f->GetMTime() : 0);
-    signature << ';' << LabelFunctionSignature(segmentation, in.SegmentIds, property->GetScalarOpacityUnitDistance());
-    if (signature.str() != in.LabelFunctionSignature || !in.SegmentProperty)
-    {
-      // A new copy: DeepCopy would keep the label functions of segments
-      // that are hidden now.
-      in.SegmentProperty = vtkSmartPointer<vtkVolumeProperty>::New();
-      in.SegmentProperty->DeepCopy(property);
-      vtkSlicerMultiMaterialVolumeRenderingLogic::SetSegmentLabelFunctions(node, in.SegmentIds, in.SegmentProperty);
-      in.LabelFunctionSignature = signature.str();
-    }
+    vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(node, in.SegmentIds, in.Mapper);
     if (in.Mapper->GetMaskInput() != in.LabelMap.GetPointer())
       in.Mapper->SetMaskInput(in.LabelMap);
     in.Mapper->SetMaskTypeToLabelMap();
-    if (in.Volume->GetProperty() != in.SegmentProperty)
-      in.Volume->SetProperty(in.SegmentProperty);
     vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentMaterialParameters(node, in.SegmentIds, in.Mapper);
   }
   else
   {
     if (in.Mapper->GetMaskInput())
       in.Mapper->SetMaskInput(nullptr);
-    if (in.Volume->GetProperty() != property)
-      in.Volume->SetProperty(property);
+    in.Mapper->RemoveAllLabelMaterials();
   }
 
   const std::string description = std::string(node->GetMaterialPreset()) + '\n' + node->GetSceneJSON();

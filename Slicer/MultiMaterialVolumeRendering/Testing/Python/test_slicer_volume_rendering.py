@@ -278,6 +278,41 @@ class SegmentationTest(unittest.TestCase):
         self.assertLess(blue2, 0.02 * blue, "the hidden liver is gone")
         self.assertGreater(red2, 0.9 * red, "the other segments stay (and show behind the liver)")
 
+    def test_segment_edits_do_only_their_work(self):
+        """A segment's colour, 3D opacity and visibility reach the mapper as
+        its label material (the one label rule), each edit a refit and a
+        restart, never a rebuild or a new label map; a render without an
+        edit does nothing; the volume property node's property is the
+        mapper's own, and rendering leaves its modification time alone.
+        Catches a pipeline that copies or edits the property per edit, or
+        exports the label map again for a look change."""
+        m = self.view.mapper()
+        prop = self.display.GetVolumePropertyNode().GetVolumeProperty()
+        self.assertIs(self.view.path_traced_volume().GetProperty(), prop, "no copy of the property")
+        rgbo = [0.0] * 4
+        self.assertTrue(m.GetLabelMaterial(self.LIVER, rgbo))
+        self.assertEqual(rgbo, [1.0, 0.0, 0.0, 1.0])
+        before = prop.GetMTime()
+        counts = self.counts()
+        self.view.render()
+        self.assertEqual(self.counts(), counts, "an unchanged render does nothing")
+        label_map_time = m.GetMaskInput().GetMTime()
+        for edit, expected in (
+                (lambda: self.seg_display.SetSegmentOverrideColor(self.liver, 0.0, 0.0, 1.0), [0.0, 0.0, 1.0, 1.0]),
+                (lambda: self.seg_display.SetSegmentOpacity3D(self.liver, 0.4), [0.0, 0.0, 1.0, 0.4]),
+                (lambda: self.seg_display.SetSegmentVisibility(self.liver, False), None)):
+            builds, refits, restarts = self.counts()
+            edit()
+            self.view.render()
+            self.assertEqual(self.counts(), (builds, refits + 1, restarts + 1))
+            self.assertEqual(m.GetMaskInput().GetMTime(), label_map_time, "the label map stays")
+            if expected is None:
+                self.assertFalse(m.GetLabelMaterial(self.LIVER, rgbo), "a hidden segment has no material")
+            else:
+                self.assertTrue(m.GetLabelMaterial(self.LIVER, rgbo))
+                self.assertEqual([round(v, 6) for v in rgbo], expected)
+        self.assertEqual(prop.GetMTime(), before, "rendering left the property alone")
+
     def test_segment_material_parameters(self):
         before = self.view.pixels()
         self.display.SetSegmentMaterialParameters(self.liver, '{"emission": [0, 3, 0]}')
