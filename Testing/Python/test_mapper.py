@@ -625,6 +625,34 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(s.mapper.GetAccumulatedSamples(), samples[-1], "converged: no more samples")
 
+    def test_choosing_another_scalar_array_rebuilds(self):
+        """The array the mapper renders (SelectScalarArray, as ParaView's
+        ColorBy sets it) is part of what the proxies are made of: choosing
+        another array of the same image rebuilds and shows it. Catches a
+        mapper that notices only the image's modification time (it kept
+        rendering the first array)."""
+        s = Scene()
+        s.shift.Update()
+        image = vtkImageData()
+        image.DeepCopy(s.shift.GetOutput())
+        ct = image.GetPointData().GetScalars()
+        ct.SetName("ct")
+        empty = vtkFloatArray()
+        empty.SetName("empty")
+        empty.SetNumberOfTuples(ct.GetNumberOfTuples())
+        empty.Fill(0.0)
+        image.GetPointData().AddArray(empty)
+        s.mapper.SetInputData(image)
+        s.mapper.SetScalarModeToUsePointFieldData()
+        s.mapper.SelectScalarArray("ct")
+        s.render()
+        self.assertGreater(coverage(s.pixels()), 0.05, "the CT array shows")
+        builds = s.counts()[0]
+        s.mapper.SelectScalarArray("empty")
+        s.render()
+        self.assertEqual(s.counts()[0], builds + 1, "another array: a rebuild")
+        self.assertLess(coverage(s.pixels()), 0.01, "the empty array shows nothing")
+
     def test_bounces_and_accelerator(self):
         s = Scene()
         s.render()

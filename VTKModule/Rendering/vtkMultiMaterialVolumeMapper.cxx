@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <vtkCamera.h>
@@ -56,29 +57,43 @@ vtkStandardNewMacro(vtkMultiMaterialVolumeMapper);
 // times where VTK keeps them; the view by value (SameView).
 struct vtkMultiMaterialVolumeMapper::InputState
 {
-  // Proxies.
-  vtkImageData* Data = nullptr;
-  vtkMTimeType DataTime = 0;
-  vtkImageData* Mask = nullptr;
-  vtkMTimeType MaskTime = 0;
-  int MaskType = -1;
-  vtkMultiMaterialProperty* MultiMaterial = nullptr;
-  vtkDataArray* Scalars = nullptr;
-  int Dependent = -1;    // components used as colour + opacity (IndependentComponents off)
-  int Independent = -1;  // components mixed additively (IndependentComponents on)
-  int ComponentGradients = -1;  // independent components with gradient opacity (bit c)
-  bool NeedGradient = false;    // a gradient-magnitude proxy (without a description)
+  struct ProxyInputs
+  {
+    vtkImageData* Data = nullptr;
+    vtkMTimeType DataTime = 0;
+    vtkDataArray* Scalars = nullptr;  // the array the mapper's scalar mode picks
+    vtkImageData* Mask = nullptr;
+    vtkMTimeType MaskTime = 0;
+    int MaskType = -1;
+    vtkMultiMaterialProperty* MultiMaterial = nullptr;
+    int Dependent = -1;    // components used as colour + opacity (IndependentComponents off)
+    int Independent = -1;  // components mixed additively (IndependentComponents on)
+    int ComponentGradients = -1;  // independent components with gradient opacity (bit c)
+    bool NeedGradient = false;    // a gradient-magnitude proxy (without a description)
+    bool operator==(const ProxyInputs& o) const
+    {
+      return std::tie(this->Data, this->DataTime, this->Scalars, this->Mask, this->MaskTime, this->MaskType,
+               this->MultiMaterial, this->Dependent, this->Independent, this->ComponentGradients,
+               this->NeedGradient) == std::tie(o.Data, o.DataTime, o.Scalars, o.Mask, o.MaskTime, o.MaskType,
+                                       o.MultiMaterial, o.Dependent, o.Independent, o.ComponentGradients,
+                                       o.NeedGradient);
+    }
+  } Proxies;
 
-  // Materials.
-  vtkVolumeProperty* Property = nullptr;
-  vtkMTimeType PropertyTime = 0, MultiMaterialTime = 0, LabelParametersTime = 0;
+  struct MaterialInputs
+  {
+    vtkVolumeProperty* Property = nullptr;
+    vtkMTimeType PropertyTime = 0, MultiMaterialTime = 0, LabelMaterialsTime = 0;
+  } Materials;
 
-  // View.
-  int Width = 0, Height = 0;  // the viewport's
-  std::vector<double> View;   // with the size, compared by SameView
-  std::vector<mmrtm::ClipPlane> Clip;
-  std::vector<float> Depth;  // the depth buffer under the volume
-  vtkMTimeType TracingTime = 0;
+  struct ViewInputs
+  {
+    int Width = 0, Height = 0;  // the viewport's
+    std::vector<double> Values;  // camera, lights, matrix, size, clipping, environment: SameView
+    std::vector<mmrtm::ClipPlane> Clip;
+    std::vector<float> Depth;  // the depth buffer under the volume
+    vtkMTimeType TracingTime = 0;
+  } View;
 };
 
 // Which phases a render must run: the answer of ChangesSince.
@@ -630,7 +645,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       this->UpdateProxies(now);
     else if (changes.Description)
       this->UpdateDescription(now);
-    if (!now.MultiMaterial && (changes.Proxies || changes.Materials))
+    if (!now.Proxies.MultiMaterial && (changes.Proxies || changes.Materials))
       this->UpdateMaterials(now);
     const bool restart = changes.Any() || !in.Film;
     if (restart)
@@ -677,54 +692,55 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   // The input brought up to date (a new or modified input rebuilds).
   this->GetInputAlgorithm()->UpdateInformation();
   this->GetInputAlgorithm()->Update();
-  now.Data = vtkImageData::SafeDownCast(this->GetInput());
-  if (!now.Data)
+  now.Proxies.Data = vtkImageData::SafeDownCast(this->GetInput());
+  if (!now.Proxies.Data)
     throw mmrtm::InputError("the input is not a vtkImageData");
-  now.DataTime = now.Data->GetMTime();
-  now.Mask = in.Mask;
-  now.MaskTime = in.Mask ? in.Mask->GetMTime() : 0;
-  now.MaskType = this->MaskType;
-  now.MultiMaterial = in.MultiMaterial;
+  now.Proxies.DataTime = now.Proxies.Data->GetMTime();
+  now.Proxies.Mask = in.Mask;
+  now.Proxies.MaskTime = in.Mask ? in.Mask->GetMTime() : 0;
+  now.Proxies.MaskType = this->MaskType;
+  now.Proxies.MultiMaterial = in.MultiMaterial;
   int cellFlag = 0;
-  now.Scalars = vtkAbstractMapper::GetScalars(
-    now.Data, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
-  if (!now.Scalars || cellFlag)
+  now.Proxies.Scalars = vtkAbstractMapper::GetScalars(
+    now.Proxies.Data, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+  if (!now.Proxies.Scalars || cellFlag)
     throw mmrtm::InputError("the input needs point scalars");
 
   // The proxies the property asks for.
   vtkVolumeProperty* property = vol->GetProperty();
-  const int components = now.Scalars->GetNumberOfComponents();
-  now.Dependent = !property->GetIndependentComponents() && (components == 2 || components == 4) ? components : 0;
-  now.Independent = property->GetIndependentComponents() && components > 1 ? std::min(components, 4) : 0;
+  const int components = now.Proxies.Scalars->GetNumberOfComponents();
+  const bool independent = property->GetIndependentComponents() != 0;
+  now.Proxies.Dependent = !independent && (components == 2 || components == 4) ? components : 0;
+  now.Proxies.Independent = independent && components > 1 ? std::min(components, 4) : 0;
   // 4 dependent components fill the 4 proxies: no room for a gradient.
   const bool labels = in.Mask && this->MaskType == LABELMAP;
-  now.NeedGradient = !in.MultiMaterial && now.Dependent != 4 && !now.Independent &&
+  now.Proxies.NeedGradient = !in.MultiMaterial && now.Proxies.Dependent != 4 && !now.Proxies.Independent &&
     mmrtm::NeedsGradientProxy(property, 0, labels);
-  now.ComponentGradients = 0;
-  for (int c = 0; c < now.Independent; ++c)
-    now.ComponentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
-  if (in.Warn("components", components > 4 && now.Independent))
+  now.Proxies.ComponentGradients = 0;
+  for (int c = 0; c < now.Proxies.Independent; ++c)
+    now.Proxies.ComponentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
+  if (in.Warn("components", components > 4 && now.Proxies.Independent))
     vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
-  if (in.Warn("mask with components", now.Independent && in.Mask))
+  if (in.Warn("mask with components", now.Proxies.Independent && in.Mask))
     vtkWarningMacro("with independent components, the mask is not used");
 
-  now.Property = property;
-  now.PropertyTime = PropertyMTime(property);
-  now.MultiMaterialTime = in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0;
-  now.LabelParametersTime = in.LabelMaterialsTime.GetMTime();
+  now.Materials.Property = property;
+  now.Materials.PropertyTime = PropertyMTime(property);
+  now.Materials.MultiMaterialTime = in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0;
+  now.Materials.LabelMaterialsTime = in.LabelMaterialsTime.GetMTime();
 
   // Camera, lights, matrix, viewport (by value), clipping, the environment,
   // the opaque geometry (its depth), and the mapper's own settings.
-  now.Width = viewport[0];
-  now.Height = viewport[1];
-  now.View = ViewSignature(ren, vol, now.Width, now.Height);
-  now.Clip = this->ClipPlanes(vol);
-  for (const mmrtm::ClipPlane& p : now.Clip)
-    now.View.insert(now.View.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
+  now.View.Width = viewport[0];
+  now.View.Height = viewport[1];
+  now.View.Values = ViewSignature(ren, vol, now.View.Width, now.View.Height);
+  now.View.Clip = this->ClipPlanes(vol);
+  for (const mmrtm::ClipPlane& p : now.View.Clip)
+    now.View.Values.insert(now.View.Values.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
   this->UpdateEnvironment();
-  now.View.push_back(static_cast<double>(in.EnvironmentTime));
-  now.Depth = ReadDepth(ren, viewport[0], viewport[1], viewport[2], viewport[3]);
-  now.TracingTime = this->TracingMTime();
+  now.View.Values.push_back(static_cast<double>(in.EnvironmentTime));
+  now.View.Depth = ReadDepth(ren, viewport[0], viewport[1], viewport[2], viewport[3]);
+  now.View.TracingTime = this->TracingMTime();
   return now;
 }
 
@@ -732,16 +748,15 @@ vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince
   const InputState& built, const InputState& now)
 {
   Changes c;
-  c.Proxies = !this->Internal->HasScene || now.Data != built.Data || now.DataTime != built.DataTime ||
-    now.Mask != built.Mask || now.MaskTime != built.MaskTime || now.MaskType != built.MaskType ||
-    now.MultiMaterial != built.MultiMaterial || now.Dependent != built.Dependent ||
-    now.Independent != built.Independent || now.ComponentGradients != built.ComponentGradients ||
-    now.NeedGradient != built.NeedGradient;
-  c.Description = now.MultiMaterial && now.MultiMaterialTime != built.MultiMaterialTime;
-  c.Materials = !now.MultiMaterial &&
-    (now.Property != built.Property || now.PropertyTime != built.PropertyTime ||
-      now.LabelParametersTime != built.LabelParametersTime);
-  c.View = !SameView(now.View, built.View) || now.Depth != built.Depth || now.TracingTime != built.TracingTime;
+  c.Proxies = !this->Internal->HasScene || !(now.Proxies == built.Proxies);
+  const bool description = now.Proxies.MultiMaterial != nullptr;
+  c.Description = description && now.Materials.MultiMaterialTime != built.Materials.MultiMaterialTime;
+  c.Materials = !description &&
+    (now.Materials.Property != built.Materials.Property ||
+      now.Materials.PropertyTime != built.Materials.PropertyTime ||
+      now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime);
+  c.View = !SameView(now.View.Values, built.View.Values) || now.View.Depth != built.View.Depth ||
+    now.View.TracingTime != built.View.TracingTime;
   return c;
 }
 
@@ -749,27 +764,17 @@ void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
 {
   Internals& in = *this->Internal;
   in.HasScene = false;  // until the rebuild succeeds
-  const bool labels = now.Mask && now.MaskType == LABELMAP;
-  this->BuildProxies(
-    now.Property, now.Data, now.Scalars, now.Dependent, now.Independent, now.NeedGradient, labels);
+  const bool labels = now.Proxies.Mask && now.Proxies.MaskType == LABELMAP;
+  const InputState::ProxyInputs& p = now.Proxies;
+  this->BuildProxies(now.Materials.Property, p.Data, p.Scalars, p.Dependent, p.Independent, p.NeedGradient, labels);
   in.LightsFromScene = false;
-  if (now.MultiMaterial)
+  if (now.Proxies.MultiMaterial)
     this->ParseMultiMaterialScene();
   for (const mmrtm::HostVolume& v : in.Scene.proxies)
     in.ImageIndexToWorld.push_back(v.indexToWorld);
   in.Scene.MarkDataModified();
-  InputState& built = in.Built;
-  built.Data = now.Data;
-  built.DataTime = now.DataTime;
-  built.Mask = now.Mask;
-  built.MaskTime = now.MaskTime;
-  built.MaskType = now.MaskType;
-  built.MultiMaterial = now.MultiMaterial;
-  built.MultiMaterialTime = now.MultiMaterialTime;
-  built.Dependent = now.Dependent;
-  built.Independent = now.Independent;
-  built.ComponentGradients = now.ComponentGradients;
-  built.NeedGradient = now.NeedGradient;
+  in.Built.Proxies = now.Proxies;
+  in.Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime;  // parsed over them
   ++in.SceneBuilds;
 }
 
@@ -778,27 +783,25 @@ void vtkMultiMaterialVolumeMapper::UpdateDescription(const InputState& now)
   // An edited description over unchanged data: parsed again over the
   // proxies as they are, and refitted.
   this->ReparseMultiMaterialScene();
-  this->Internal->Built.MultiMaterialTime = now.MultiMaterialTime;
+  this->Internal->Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime;
 }
 
 void vtkMultiMaterialVolumeMapper::UpdateMaterials(const InputState& now)
 {
   // The transfer functions translated again (the scene's build refits).
   Internals& in = *this->Internal;
-  if (const int nonFinite = mmrtm::SetMaterialsFromProperty(now.Property, 0, in.Layout, in.Scene))
+  if (const int nonFinite = mmrtm::SetMaterialsFromProperty(now.Materials.Property, 0, in.Layout, in.Scene))
     vtkWarningMacro(<< "the volume property holds " << nonFinite
                     << " value(s) that are not finite (NaN in a transfer function or a component "
                        "weight); they were read as 0");
   if (in.Layout.labels >= 0)
   {
     for (const auto& [label, look] : in.LabelLooks)
-      mmrtm::SetLabelLook(label, look, now.Property, 0, in.Layout, in.Scene);
+      mmrtm::SetLabelLook(label, look, now.Materials.Property, 0, in.Layout, in.Scene);
     for (const auto& [label, json] : in.LabelMaterialParameters)
       mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
   }
-  in.Built.Property = now.Property;
-  in.Built.PropertyTime = now.PropertyTime;
-  in.Built.LabelParametersTime = now.LabelParametersTime;
+  in.Built.Materials = now.Materials;
   ++in.Refits;
 }
 
@@ -811,16 +814,16 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
   for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
     in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
   mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
-  const int width = now.Width, height = now.Height;
+  const int width = now.View.Width, height = now.View.Height;
   // Camera rays stop at opaque geometry: it hides the volume behind it,
   // and the volume in front of it hides it.
   in.Scene.cameraRayMaxDistance =
-    now.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, now.Depth, width, height);
+    now.View.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, now.View.Depth, width, height);
   if (!in.LightsFromScene)
-    mmrtm::SetLightsFromVtk(ren, now.Property, in.Scene);
+    mmrtm::SetLightsFromVtk(ren, now.Materials.Property, in.Scene);
   if (in.Environment)
     in.Scene.environment = in.Environment;
-  in.Scene.clipPlanes = now.Clip;
+  in.Scene.clipPlanes = now.View.Clip;
   mmrtm::RenderSettings& rs = in.Scene.render;
   rs.width = width;
   rs.height = height;
@@ -837,9 +840,6 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
   rs.integrator.backgroundVisible = false;  // VTK's background shows through
   in.Film = std::make_unique<mmrtm::Film>(width, height);
   in.Built.View = std::move(now.View);
-  in.Built.Clip = std::move(now.Clip);
-  in.Built.Depth = std::move(now.Depth);
-  in.Built.TracingTime = now.TracingTime;
   in.HasScene = true;
   ++in.Restarts;
 }
@@ -1146,7 +1146,7 @@ void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, in
   rs.width = w;
   rs.height = h;
   // The depth buffer at the preview's pixel centres.
-  const std::vector<float>& fullDepth = in.Built.Depth;
+  const std::vector<float>& fullDepth = in.Built.View.Depth;
   if (!fullDepth.empty())
   {
     std::vector<float> depth(static_cast<size_t>(w) * h);
