@@ -68,10 +68,14 @@ HostVolume Resample(const HostVolume& in, int n) {
       for (int x = 0; x < n; ++x) {
         const float value = v.SampleIndex(scale.ApplyPoint({(float)x, (float)y, (float)z}));
         const size_t i = x + (size_t)n * (y + (size_t)n * z);
-        if (in.type == VoxelType::Int16) reinterpret_cast<int16_t*>(out.voxels.data())[i] = (int16_t)std::lround(value);
-        else if (in.type == VoxelType::UInt16) reinterpret_cast<uint16_t*>(out.voxels.data())[i] = (uint16_t)std::lround(value);
-        else if (in.type == VoxelType::UInt8) out.voxels[i] = (uint8_t)std::lround(value);
-        else reinterpret_cast<float*>(out.voxels.data())[i] = value;
+        if (in.type == VoxelType::Int16)
+          reinterpret_cast<int16_t*>(out.voxels.data())[i] = (int16_t)std::lround(value);
+        else if (in.type == VoxelType::UInt16)
+          reinterpret_cast<uint16_t*>(out.voxels.data())[i] = (uint16_t)std::lround(value);
+        else if (in.type == VoxelType::UInt8)
+          out.voxels[i] = (uint8_t)std::lround(value);
+        else
+          reinterpret_cast<float*>(out.voxels.data())[i] = value;
       }
   return out;
 }
@@ -102,7 +106,6 @@ struct Result {
   int64_t nodes = 0;
   uint64_t violations = 0;
 };
-
 
 // Nearest and farthest non-empty point along every camera ray (pixel
 // centres): the majorant segments say where the volume may be non-empty; the
@@ -149,13 +152,20 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto next = [&]() { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (a == "--json") jsonOut = next();
-    else if (a == "--width") width = std::atoi(next().c_str());
-    else if (a == "--spp") spp = std::atoi(next().c_str());
-    else if (a == "--threads") threads = std::atoi(next().c_str());
-    else if (a == "--shared-data") sharedDir = next();
-    else if (a == "--no-ideal") withIdeal = false;
-    else if (a == "--quick") quick = true;
+    if (a == "--json")
+      jsonOut = next();
+    else if (a == "--width")
+      width = std::atoi(next().c_str());
+    else if (a == "--spp")
+      spp = std::atoi(next().c_str());
+    else if (a == "--threads")
+      threads = std::atoi(next().c_str());
+    else if (a == "--shared-data")
+      sharedDir = next();
+    else if (a == "--no-ideal")
+      withIdeal = false;
+    else if (a == "--quick")
+      quick = true;
     else {
       std::printf(
           "usage: mmrtm-bench-accelerators [--width W (512)] [--spp N (10)] [--threads T (all)] [--json FILE]\n"
@@ -246,9 +256,9 @@ int main(int argc, char** argv) {
       r.unchanged = unchanged[unchanged.size() / 2];
       float minSpacing = kInfinity;
       for (int a = 0; a < 3; ++a)
-        minSpacing = std::min(minSpacing, Length(Vec3{scene.proxies[0].indexToWorld.m[0][a],
-                                                      scene.proxies[0].indexToWorld.m[1][a],
-                                                      scene.proxies[0].indexToWorld.m[2][a]}));
+        minSpacing = std::min(minSpacing,
+                              Length(Vec3{scene.proxies[0].indexToWorld.m[0][a], scene.proxies[0].indexToWorld.m[1][a],
+                                          scene.proxies[0].indexToWorld.m[2][a]}));
       r.locate = Locate(view, width, 0.5f * minSpacing);
       Film film(width, width);
       TraceCounters ctr;
@@ -263,20 +273,27 @@ int main(int argc, char** argv) {
       }
       r.meanZ2 = MeanSquaredZScore(noneFilm, film);
       results.push_back(r);
-      std::printf("%-20s %-20s %5d %9.2f %9.2f %9.2f %9.1f %9.2f %8.2f %8.2f %7.3f%s\n", d.name.c_str(),
-                  c.name.c_str(), r.leafLevel, r.build * 1e3, r.refit * 1e3, r.unchanged * 1e6, r.locate * 1e3,
-                  r.render, noneRender / r.render, r.lookupsPerReal, r.meanZ2, r.violations ? "  (majorant violations!)" : "");
+      std::printf("%-20s %-20s %5d %9.2f %9.2f %9.2f %9.1f %9.2f %8.2f %8.2f %7.3f%s\n", d.name.c_str(), c.name.c_str(),
+                  r.leafLevel, r.build * 1e3, r.refit * 1e3, r.unchanged * 1e6, r.locate * 1e3, r.render,
+                  noneRender / r.render, r.lookupsPerReal, r.meanZ2, r.violations ? "  (majorant violations!)" : "");
       std::fflush(stdout);
     }
   }
 
   json out = json::array();
   for (const Result& r : results)
-    out.push_back({{"dataset", r.dataset}, {"accelerator", r.config}, {"leaf_level", r.leafLevel},
-                   {"nodes", r.nodes}, {"build_seconds", r.build}, {"refit_seconds", r.refit},
+    out.push_back({{"dataset", r.dataset},
+                   {"accelerator", r.config},
+                   {"leaf_level", r.leafLevel},
+                   {"nodes", r.nodes},
+                   {"build_seconds", r.build},
+                   {"refit_seconds", r.refit},
                    {"unchanged_build_seconds", r.unchanged},
-                   {"locate_seconds", r.locate}, {"gi_seconds", r.render}, {"lookups_per_real_collision", r.lookupsPerReal},
-                   {"mean_z2_vs_none", r.meanZ2}, {"majorant_violations", r.violations}});
+                   {"locate_seconds", r.locate},
+                   {"gi_seconds", r.render},
+                   {"lookups_per_real_collision", r.lookupsPerReal},
+                   {"mean_z2_vs_none", r.meanZ2},
+                   {"majorant_violations", r.violations}});
   std::ofstream(jsonOut) << json({{"width", width}, {"spp", spp}, {"results", out}}).dump(2) << "\n";
   std::printf("wrote %s\n", jsonOut.c_str());
   return 0;

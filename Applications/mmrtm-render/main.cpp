@@ -111,23 +111,28 @@ json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t 
   const auto& dims = scene.proxies.at(0).dims;
   const double voxels = (double)dims[0] * dims[1] * dims[2];
   const size_t held = f.voxels + f.tables + f.majorants + f.minorants + summaries;
-  return {{"input_voxel_bytes", inputVoxelBytes}, {"proxy_voxel_bytes", f.voxels}, {"tf_table_bytes", f.tables},
-          {"majorant_bytes", f.majorants}, {"minorant_bytes", f.minorants}, {"summary_bytes", summaries},
+  return {{"input_voxel_bytes", inputVoxelBytes},
+          {"proxy_voxel_bytes", f.voxels},
+          {"tf_table_bytes", f.tables},
+          {"majorant_bytes", f.majorants},
+          {"minorant_bytes", f.minorants},
+          {"summary_bytes", summaries},
           {"environment_bytes", f.environment},
           {"grid_leaves", scene.Grid() ? scene.Grid()->LeafCount() : 0},
           {"distinct_leaf_summaries", scene.Grid() ? scene.Grid()->Summaries().Count() : 0},
-          {"voxels", voxels}, {"bytes_per_voxel", held / voxels},
+          {"voxels", voxels},
+          {"bytes_per_voxel", held / voxels},
           {"input_bytes_per_voxel", inputVoxelBytes / voxels}};
 }
 
 struct Options {
   std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear,
-      outputVariance, statsJson, denoisedPreview;
+                                                                outputVariance, statsJson, denoisedPreview;
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
   bool quiet = false, listSeries = false;
-  double noiseTarget = 0;  // 0: render all --spp samples
-  bool adaptive = false;   // --sampling adaptive
+  double noiseTarget = 0;     // 0: render all --spp samples
+  bool adaptive = false;      // --sampling adaptive
   int previewFeatureSpp = 0;  // --preview-features: first-hit feature samples per pixel, 0: none
 };
 
@@ -146,8 +151,8 @@ long ParseInteger(const std::string& flag, const std::string& text, long lo, lon
   errno = 0;
   long v = std::strtol(text.c_str(), &end, 10);
   if (text.empty() || *end || errno || v < lo || v > hi)
-    UsageError(flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
-               text + "'");
+    UsageError(flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" + text +
+               "'");
   return v;
 }
 
@@ -176,26 +181,39 @@ Options ParseArguments(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       std::printf(kUsage, mmrtm::DefaultVolumePath().c_str(), (DataDirectory() + "/presets").c_str());
       std::exit(0);
-    } else if (a == "--scene") o.scene = value();
-    else if (a == "--preset") o.preset = value();
-    else if (a == "--labels") o.labels = value();
-    else if (a == "--label-table") o.labelTable = value();
-    else if (a == "--series") o.series = value();
-    else if (a == "--list-series") o.listSeries = true;
-    else if (a == "--width") o.render["width"] = ParseInteger(a, value(), 1, 16384);
-    else if (a == "--height") o.render["height"] = ParseInteger(a, value(), 1, 16384);
-    else if (a == "--spp") o.render["spp"] = ParseInteger(a, value(), 1, 1 << 24);
-    else if (a == "--seed") o.render["seed"] = (uint64_t)ParseInteger(a, value(), 0, 0x7fffffffL);
-    else if (a == "--threads") o.render["threads"] = ParseInteger(a, value(), 0, 1024);
+    } else if (a == "--scene")
+      o.scene = value();
+    else if (a == "--preset")
+      o.preset = value();
+    else if (a == "--labels")
+      o.labels = value();
+    else if (a == "--label-table")
+      o.labelTable = value();
+    else if (a == "--series")
+      o.series = value();
+    else if (a == "--list-series")
+      o.listSeries = true;
+    else if (a == "--width")
+      o.render["width"] = ParseInteger(a, value(), 1, 16384);
+    else if (a == "--height")
+      o.render["height"] = ParseInteger(a, value(), 1, 16384);
+    else if (a == "--spp")
+      o.render["spp"] = ParseInteger(a, value(), 1, 1 << 24);
+    else if (a == "--seed")
+      o.render["seed"] = (uint64_t)ParseInteger(a, value(), 0, 0x7fffffffL);
+    else if (a == "--threads")
+      o.render["threads"] = ParseInteger(a, value(), 0, 1024);
     else if (a == "--backend") {
       const std::string b = value();
       const auto backend = mmrtm::ParseBackend(b);
       if (!backend) UsageError("--backend expects auto, cpu or cuda, got '" + b + "'");
       o.backend = *backend;
-    }
-    else if (a == "--max-bounces") o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);
-    else if (a == "--shadow-scale") o.render["shadow_extinction_scale"] = ParseReal(a, value());
-    else if (a == "--exposure") o.render["exposure"] = ParseReal(a, value());
+    } else if (a == "--max-bounces")
+      o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);
+    else if (a == "--shadow-scale")
+      o.render["shadow_extinction_scale"] = ParseReal(a, value());
+    else if (a == "--exposure")
+      o.render["exposure"] = ParseReal(a, value());
     else if (a == "--estimator") {
       std::string e = value();
       if (e != "delta" && e != "raymarch") UsageError("--estimator expects delta or raymarch, got '" + e + "'");
@@ -205,24 +223,30 @@ Options ParseArguments(int argc, char** argv) {
       if (e != "none" && e != "macrocell" && e != "octree" && e != "octree-voxelmax")
         UsageError("--accelerator expects none, macrocell, octree or octree-voxelmax, got '" + e + "'");
       o.render["accelerator"] = e;
-    } else if (a == "--leaf-level") o.render["leaf_level"] = ParseInteger(a, value(), -1, 11);
-    else if (a == "--output") o.output = value();
-    else if (a == "--output-linear") o.outputLinear = value();
+    } else if (a == "--leaf-level")
+      o.render["leaf_level"] = ParseInteger(a, value(), -1, 11);
+    else if (a == "--output")
+      o.output = value();
+    else if (a == "--output-linear")
+      o.outputLinear = value();
     else if (a == "--denoised-preview") {
       o.denoisedPreview = value();
       const std::string ext = LowerExtension(o.denoisedPreview);
       if (ext != ".png" && ext != ".pfm")
         UsageError("--denoised-preview expects a .png or .pfm file, got '" + o.denoisedPreview + "'");
-    }
-    else if (a == "--preview-features") o.previewFeatureSpp = (int)ParseInteger(a, value(), 0, 4096);
-    else if (a == "--output-variance") o.outputVariance = value();
-    else if (a == "--ray-march-step") o.render["ray_march_step"] = ParseReal(a, value());
-    else if (a == "--stats-json") o.statsJson = value();
+    } else if (a == "--preview-features")
+      o.previewFeatureSpp = (int)ParseInteger(a, value(), 0, 4096);
+    else if (a == "--output-variance")
+      o.outputVariance = value();
+    else if (a == "--ray-march-step")
+      o.render["ray_march_step"] = ParseReal(a, value());
+    else if (a == "--stats-json")
+      o.statsJson = value();
     else if (a == "--noise-target") {
       o.noiseTarget = ParseReal(a, value());
-      if (!(o.noiseTarget > 0 && o.noiseTarget < 1)) UsageError("--noise-target expects a relative noise in (0, 1), e.g. 0.01");
-    }
-    else if (a == "--light-sampling") {
+      if (!(o.noiseTarget > 0 && o.noiseTarget < 1))
+        UsageError("--noise-target expects a relative noise in (0, 1), e.g. 0.01");
+    } else if (a == "--light-sampling") {
       const std::string v = value();
       if (!mmrtm::ParseLightSampling(v)) UsageError("--light-sampling expects one, all or resampled, got '" + v + "'");
       o.render["light_sampling"] = v;
@@ -234,10 +258,14 @@ Options ParseArguments(int argc, char** argv) {
       const std::string v = value();
       if (!mmrtm::ParsePixelSampler(v)) UsageError("--sampler expects sobol or independent, got '" + v + "'");
       o.render["sampler"] = v;
-    } else if (a == "--quiet") o.quiet = true;
-    else if (a.size() > 1 && a[0] == '-') UsageError("unknown option " + a);
-    else if (o.input.empty()) o.input = a;
-    else UsageError("more than one INPUT given ('" + o.input + "' and '" + a + "')");
+    } else if (a == "--quiet")
+      o.quiet = true;
+    else if (a.size() > 1 && a[0] == '-')
+      UsageError("unknown option " + a);
+    else if (o.input.empty())
+      o.input = a;
+    else
+      UsageError("more than one INPUT given ('" + o.input + "' and '" + a + "')");
   }
   return o;
 }
@@ -271,9 +299,7 @@ class ProgressBar {
                  terminal_ && done != total ? " " : "\n");
     std::fflush(stderr);
   }
-  double Seconds() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
+  double Seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
 
  private:
   bool enabled_, terminal_;
@@ -310,14 +336,12 @@ int NextPassTowards(double noiseTarget, double noise, double done) {
 // rendered in one go with as many samples. Returns whether the target was
 // reached.
 bool RenderUniformly(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, const mmrtm::SceneView& view,
-                     mmrtm::Film& film, int spp, double noiseTarget, mmrtm::TraceCounters& counters,
-                     ProgressBar& bar) {
+                     mmrtm::Film& film, int spp, double noiseTarget, mmrtm::TraceCounters& counters, ProgressBar& bar) {
   int pass = noiseTarget > 0 ? 4 : spp;
   for (int done = 0; done < spp;) {
     pass = std::min(pass, spp - done);
-    renderer.Render(scene, view, film, pass, &counters, [&](int d, int t) {
-      bar((int)(1000.0 * (done + pass * (double)d / t) / spp), 1000);
-    });
+    renderer.Render(scene, view, film, pass, &counters,
+                    [&](int d, int t) { bar((int)(1000.0 * (done + pass * (double)d / t) / spp), 1000); });
     done += pass;
     if (noiseTarget > 0 && film.Samples() >= 2) {
       const double noise = film.Noise().relative;
@@ -349,9 +373,8 @@ bool RenderAdaptively(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, cons
     mean = noiseTarget > 0 ? std::min<double>(spp, mean + NextPassTowards(noiseTarget, noise, mean)) : spp;
     const std::vector<uint32_t> counts =
         mmrtm::AdaptiveSampleCounts(film, weights, mean, (uint32_t)std::min(16.0 * mean, 1e9));
-    renderer.RenderTo(scene, view, film, counts, &counters, [&](int d, int t) {
-      bar((int)(1000.0 * (before + (mean - before) * d / t) / spp), 1000);
-    });
+    renderer.RenderTo(scene, view, film, counts, &counters,
+                      [&](int d, int t) { bar((int)(1000.0 * (before + (mean - before) * d / t) / spp), 1000); });
     if (noiseTarget > 0) {
       noise = film.Noise().relative;
       if (noise <= noiseTarget) return true;
@@ -384,8 +407,11 @@ json WriteDenoisedPreview(const std::string& path, const mmrtm::Denoiser& denois
       mmrtm::ToneMapPixel(denoised.pixels[i], rs.exposure, rs.toneMapper, &png[3 * i]);
     mmrtm::WritePNG(path, denoised.width, denoised.height, 3, png);
   }
-  return {{"file", path}, {"biased", true}, {"denoiser", denoiser.Description()},
-          {"feature_spp", featureSamples}, {"seconds", {{"features", featureSeconds}, {"denoise", denoiseSeconds}}}};
+  return {{"file", path},
+          {"biased", true},
+          {"denoiser", denoiser.Description()},
+          {"feature_spp", featureSamples},
+          {"seconds", {{"features", featureSeconds}, {"denoise", denoiseSeconds}}}};
 }
 
 int ListSeries(const Options& o) {
@@ -438,8 +464,10 @@ int Run(const Options& o) {
   }
   if (!o.labelTable.empty()) {
     if (!doc.contains("label_materials"))
-      std::fprintf(stderr, "warning: --label-table %s is not used: the scene has no \"label_materials\" (try --preset ct-organs)\n",
-                   o.labelTable.c_str());
+      std::fprintf(
+          stderr,
+          "warning: --label-table %s is not used: the scene has no \"label_materials\" (try --preset ct-organs)\n",
+          o.labelTable.c_str());
     inputs.labelTable = mmrtm::ReadLabelTable(o.labelTable);
   }
   if (!o.labels.empty()) {
@@ -464,15 +492,15 @@ int Run(const Options& o) {
   mmrtm::Film film(rs.width, rs.height);
   mmrtm::TraceCounters counters;
   if (!o.quiet)
-    std::fprintf(stderr, "%d x %d, %d spp, %s, %s, majorant %.4g /mm\n", rs.width, rs.height,
-                 rs.samplesPerPixel, renderer->Description().c_str(),
+    std::fprintf(stderr, "%d x %d, %d spp, %s, %s, majorant %.4g /mm\n", rs.width, rs.height, rs.samplesPerPixel,
+                 renderer->Description().c_str(),
                  rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
                  view.majorants.globalMajorant);
   ProgressBar bar(!o.quiet);
   const int spp = rs.samplesPerPixel;
-  const bool reachedTarget =
-      o.adaptive && spp >= 4 ? RenderAdaptively(*renderer, scene, view, film, spp, o.noiseTarget, counters, bar)
-                             : RenderUniformly(*renderer, scene, view, film, spp, o.noiseTarget, counters, bar);
+  const bool reachedTarget = o.adaptive && spp >= 4
+                                 ? RenderAdaptively(*renderer, scene, view, film, spp, o.noiseTarget, counters, bar)
+                                 : RenderUniformly(*renderer, scene, view, film, spp, o.noiseTarget, counters, bar);
   if (reachedTarget) bar(1000, 1000);
   const double renderSeconds = bar.Seconds();
 
@@ -515,8 +543,8 @@ int Run(const Options& o) {
         {"estimator", rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "raymarch" : "delta"},
         {"shadow_extinction_scale", rs.integrator.shadowExtinctionScale},
         {"global_majorant", view.majorants.globalMajorant},
-        {"seconds", {{"load", loadSeconds}, {"build", buildSeconds}, {"render", renderSeconds},
-                     {"total", SecondsSince(tStart)}}},
+        {"seconds",
+         {{"load", loadSeconds}, {"build", buildSeconds}, {"render", renderSeconds}, {"total", SecondsSince(tStart)}}},
         {"samples", samples},
         {"samples_per_second", samples / renderSeconds},
         {"paths", counters.paths},
@@ -530,8 +558,10 @@ int Run(const Options& o) {
          counters.realCollisions ? (double)counters.densityLookups / counters.realCollisions : 0.0},
         {"memory", MemoryJson(scene, view, inputVoxelBytes)},
         {"denoised_preview", preview},
-        {"noise", {{"mean_luminance", noise.meanLuminance}, {"rms_standard_error", noise.rmsStandardError},
-                   {"relative", noise.relative}}}};
+        {"noise",
+         {{"mean_luminance", noise.meanLuminance},
+          {"rms_standard_error", noise.rmsStandardError},
+          {"relative", noise.relative}}}};
     const std::string tmp = o.statsJson + ".partial";
     {
       std::ofstream out(tmp);

@@ -145,8 +145,9 @@ QWidget* MainWindow::buildMaterialsPanel() {
   numbers->addWidget(new QLabel(tr("density")));
   numbers->addWidget(pointOpacity_);
   layout->addLayout(numbers);
-  auto* help = new QLabel(tr("Click: add a point; drag: move; right click or Delete: remove. "
-                             "Colour bar: double click to add or recolour a stop, right click to remove."));
+  auto* help =
+      new QLabel(tr("Click: add a point; drag: move; right click or Delete: remove. "
+                    "Colour bar: double click to add or recolour a stop, right click to remove."));
   help->setWordWrap(true);
   layout->addWidget(help);
   auto numeric = [this] { editor_->setSelectedPoint(pointValue_->value(), pointOpacity_->value()); };

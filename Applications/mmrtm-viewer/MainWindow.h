@@ -70,8 +70,8 @@ class MainWindow : public QMainWindow {
  private:
   void buildMenus();
   QWidget* buildMaterialsPanel();
-  void showScene();       // the editors from the scene, the camera fitted
-  void showMaterial();    // the editor from the chosen material
+  void showScene();     // the editors from the scene, the camera fitted
+  void showMaterial();  // the editor from the chosen material
   void applyEditor(bool interactive);
   void scheduleRender();  // another refinement step, unless converged
   void onRendered();

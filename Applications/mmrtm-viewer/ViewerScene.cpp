@@ -359,11 +359,14 @@ void ViewerScene::SaveScene(const std::string& path, vtkCamera* camera, int widt
   doc["volumes"] = {{"scalars", {{"file", volumePath_}}}};
   if (labelMap_) doc["volumes"]["labels"] = {{"file", labelsPath_}, {"interpolation", "nearest"}};
   if (!series_.empty())
-    doc["description"] = doc.value("description", "") + " DICOM series " + series_ + ": mmrtm-render --series " + series_;
+    doc["description"] =
+        doc.value("description", "") + " DICOM series " + series_ + ": mmrtm-render --series " + series_;
   const double* p = camera->GetPosition();
   const double* f = camera->GetFocalPoint();
   const double* u = camera->GetViewUp();
-  doc["camera"] = {{"position", {p[0], p[1], p[2]}}, {"look_at", {f[0], f[1], f[2]}}, {"up", {u[0], u[1], u[2]}},
+  doc["camera"] = {{"position", {p[0], p[1], p[2]}},
+                   {"look_at", {f[0], f[1], f[2]}},
+                   {"up", {u[0], u[1], u[2]}},
                    {"fov", camera->GetViewAngle()}};
   if (camera->GetParallelProjection())
     doc["camera"].update({{"projection", "orthographic"}, {"ortho_height", 2 * camera->GetParallelScale()}});
@@ -524,9 +527,9 @@ json ViewerScene::Description() const {
     for (int id : editedLabels_)
       for (const LabelEntry& l : labels_)
         if (l.id == id)
-          classes.insert(classes.begin(), json::object({{"ids", json::array({id})},
-                                                        {"color", "material"},
-                                                        {"material", LabelMaterial(Look(l))}}));
+          classes.insert(
+              classes.begin(),
+              json::object({{"ids", json::array({id})}, {"color", "material"}, {"material", LabelMaterial(Look(l))}}));
     if (!labelTablePath_.empty()) doc["label_table"] = labelTablePath_;
   } else {
     doc.erase("label_materials");
@@ -555,9 +558,8 @@ json ViewerScene::Description() const {
                                    {"camera_azimuth", settings_.lightAzimuth},
                                    {"camera_elevation", settings_.lightElevation},
                                    {"intensity", settings_.lightIntensity}}));
-  if (settings_.environment && std::none_of(edited.begin(), edited.end(), [](const json& l) {
-        return l.value("type", "") == "environment";
-      }))
+  if (settings_.environment &&
+      std::none_of(edited.begin(), edited.end(), [](const json& l) { return l.value("type", "") == "environment"; }))
     edited.insert(edited.begin(), json::object({{"type", "environment"}, {"sky", "default"}, {"intensity", 0.6}}));
   doc["lights"] = edited;
   return doc;

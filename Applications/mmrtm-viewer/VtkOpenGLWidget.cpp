@@ -100,8 +100,7 @@ void VtkOpenGLWidget::paintGL() {
   state->PushDrawFramebufferBinding();
   QOpenGLFunctions* gl = context()->functions();
   gl->glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
-  window_->BlitDisplayFramebuffer(0, 0, 0, size[0], size[1], 0, 0, size[0], size[1], GL_COLOR_BUFFER_BIT,
-                                  GL_NEAREST);
+  window_->BlitDisplayFramebuffer(0, 0, 0, size[0], size[1], 0, 0, size[0], size[1], GL_COLOR_BUFFER_BIT, GL_NEAREST);
   // Opaque: Qt composes the widget with its alpha.
   state->vtkglColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_TRUE);
   state->vtkglClearColor(0, 0, 0, 1);
@@ -201,10 +200,18 @@ void VtkOpenGLWidget::wheelEvent(QWheelEvent* event) {
 // Arrows turn the camera, +/- zoom, R resets it.
 void VtkOpenGLWidget::keyPressEvent(QKeyEvent* event) {
   switch (event->key()) {
-    case Qt::Key_Left: Rotate(-10, 0); break;
-    case Qt::Key_Right: Rotate(10, 0); break;
-    case Qt::Key_Up: Rotate(0, 10); break;
-    case Qt::Key_Down: Rotate(0, -10); break;
+    case Qt::Key_Left:
+      Rotate(-10, 0);
+      break;
+    case Qt::Key_Right:
+      Rotate(10, 0);
+      break;
+    case Qt::Key_Up:
+      Rotate(0, 10);
+      break;
+    case Qt::Key_Down:
+      Rotate(0, -10);
+      break;
     case Qt::Key_Plus:
     case Qt::Key_Equal:
       renderer_->GetActiveCamera()->Dolly(1.2);
@@ -216,8 +223,11 @@ void VtkOpenGLWidget::keyPressEvent(QKeyEvent* event) {
       emit cameraChanged();
       update();
       break;
-    case Qt::Key_R: ResetCamera(); break;
-    default: QOpenGLWidget::keyPressEvent(event);
+    case Qt::Key_R:
+      ResetCamera();
+      break;
+    default:
+      QOpenGLWidget::keyPressEvent(event);
   }
 }
 

@@ -41,12 +41,12 @@ int main(int argc, char* argv[])
   window->AddRenderer(renderer);
   window->SetSize(400, 400);
   renderer->ResetCamera();
-  renderer->GetActiveCamera()->Elevation(-90);  // this CT's face is at +y: look at it, head up
+  renderer->GetActiveCamera()->Elevation(-90); // this CT's face is at +y: look at it, head up
   renderer->GetActiveCamera()->SetViewUp(0, 0, 1);
   renderer->GetActiveCamera()->Azimuth(180);
   renderer->ResetCamera();
 
-  if (argc > 2)  // off screen: 32 samples per pixel, then the PNG
+  if (argc > 2) // off screen: 32 samples per pixel, then the PNG
   {
     window->SetOffScreenRendering(1);
     mapper->SetSamplesPerRender(8);

@@ -138,7 +138,7 @@ void vtkMultiMaterialVolumeRepresentation::UpdateMaterialSource()
   {
     // vtkMultiMaterialProperty said why; keep ParaView's functions.
     vtkErrorMacro("could not use " << (this->SceneFile.empty() ? "the preset \"" + this->Preset + "\""
-                                                              : "the scene file " + this->SceneFile)
+                                                               : "the scene file " + this->SceneFile)
                                    << ": rendering ParaView's transfer functions");
   }
   const bool useMaterials = ok && (!this->SceneFile.empty() || !this->Preset.empty());
@@ -151,7 +151,7 @@ void vtkMultiMaterialVolumeRepresentation::SetLabelMapArray(const char* name)
   if (value == this->LabelMapArray)
     return;
   this->LabelMapArray = value;
-  this->MarkModified();  // RequestData makes the mask
+  this->MarkModified(); // RequestData makes the mask
 }
 
 int vtkMultiMaterialVolumeRepresentation::GetAccumulatedSamples()
@@ -216,9 +216,8 @@ int vtkMultiMaterialVolumeRepresentation::RequestData(
 void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
 {
   vtkImageData* image = vtkImageData::SafeDownCast(this->Cache);
-  vtkDataArray* labels = image && !this->LabelMapArray.empty()
-    ? image->GetPointData()->GetArray(this->LabelMapArray.c_str())
-    : nullptr;
+  vtkDataArray* labels =
+    image && !this->LabelMapArray.empty() ? image->GetPointData()->GetArray(this->LabelMapArray.c_str()) : nullptr;
   if (!labels)
   {
     if (image && !this->LabelMapArray.empty())
@@ -229,8 +228,7 @@ void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
   }
   if (labels->GetNumberOfComponents() != 1)
   {
-    vtkWarningMacro("the label map array \"" << this->LabelMapArray << "\" has "
-                                             << labels->GetNumberOfComponents()
+    vtkWarningMacro("the label map array \"" << this->LabelMapArray << "\" has " << labels->GetNumberOfComponents()
                                              << " components, not 1: no label map");
     this->Mapper()->SetMaskInput(nullptr);
     this->Mapper()->RemoveAllLabelMaterials();
@@ -252,14 +250,13 @@ void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
   }
   if (found.size() > 64)
   {
-    vtkWarningMacro("the label map array \"" << this->LabelMapArray
-                                             << "\" has more than 64 labels: only the first 64 are materials");
+    vtkWarningMacro(
+      "the label map array \"" << this->LabelMapArray << "\" has more than 64 labels: only the first 64 are materials");
   }
   // A qualitative palette (ColorBrewer's Set1 and Dark2).
   static const double palette[][3] = { { 0.89, 0.10, 0.11 }, { 0.22, 0.49, 0.72 }, { 0.30, 0.69, 0.29 },
-    { 0.60, 0.31, 0.64 }, { 1.00, 0.50, 0.00 }, { 1.00, 1.00, 0.20 }, { 0.65, 0.34, 0.16 },
-    { 0.97, 0.51, 0.75 }, { 0.11, 0.62, 0.47 }, { 0.85, 0.37, 0.01 }, { 0.46, 0.44, 0.70 },
-    { 0.40, 0.65, 0.12 } };
+    { 0.60, 0.31, 0.64 }, { 1.00, 0.50, 0.00 }, { 1.00, 1.00, 0.20 }, { 0.65, 0.34, 0.16 }, { 0.97, 0.51, 0.75 },
+    { 0.11, 0.62, 0.47 }, { 0.85, 0.37, 0.01 }, { 0.46, 0.44, 0.70 }, { 0.40, 0.65, 0.12 } };
   const int colours = static_cast<int>(sizeof(palette) / sizeof(palette[0]));
   this->Mapper()->RemoveAllLabelMaterials();
   int index = 0;
@@ -304,8 +301,7 @@ void vtkMultiMaterialVolumeRepresentation::OnStartRender()
 {
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   vtkPVRenderView* view = vtkPVRenderView::SafeDownCast(this->ObservedView.GetPointer());
-  if (!controller || controller->GetNumberOfProcesses() < 2 || !view ||
-    !view->GetUseDistributedRenderingForRender())
+  if (!controller || controller->GetNumberOfProcesses() < 2 || !view || !view->GetUseDistributedRenderingForRender())
   {
     this->Mapper()->SetCombineThisRender(false);
     return;
@@ -313,8 +309,8 @@ void vtkMultiMaterialVolumeRepresentation::OnStartRender()
   vtkPVLODVolume* actor = this->GetRenderedProp();
   // This process renders the mapper when the actor is visible and draws
   // its full level of detail (not the outline).
-  const int mine = this->GetVisibility() && actor && actor->GetVisibility() && !actor->GetEnableLOD() &&
-      this->Cache && this->VolumeMapper->GetNumberOfInputConnections(0) > 0
+  const int mine = this->GetVisibility() && actor && actor->GetVisibility() && !actor->GetEnableLOD() && this->Cache &&
+      this->VolumeMapper->GetNumberOfInputConnections(0) > 0
     ? 1
     : 0;
   int all = 0;

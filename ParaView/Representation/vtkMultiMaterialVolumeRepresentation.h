@@ -30,20 +30,19 @@
 #ifndef vtkMultiMaterialVolumeRepresentation_h
 #define vtkMultiMaterialVolumeRepresentation_h
 
-#include "mmrtmParaViewRepresentationModule.h"  // for export macro
+#include "mmrtmParaViewRepresentationModule.h" // for export macro
 #include "vtkImageVolumeRepresentation.h"
-#include "vtkMultiMaterialProperty.h"  // for vtkNew<vtkMultiMaterialProperty>
-#include "vtkNew.h"                    // for vtkNew
-#include "vtkWeakPointer.h"             // for vtkWeakPointer
+#include "vtkMultiMaterialProperty.h" // for vtkNew<vtkMultiMaterialProperty>
+#include "vtkNew.h"                   // for vtkNew
+#include "vtkWeakPointer.h"           // for vtkWeakPointer
 
-#include <string>  // for std::string
+#include <string> // for std::string
 
 class vtkRenderer;
 class vtkSampleParallelVolumeMapper;
 class vtkView;
 
-class MMRTMPARAVIEWREPRESENTATION_EXPORT vtkMultiMaterialVolumeRepresentation
-  : public vtkImageVolumeRepresentation
+class MMRTMPARAVIEWREPRESENTATION_EXPORT vtkMultiMaterialVolumeRepresentation : public vtkImageVolumeRepresentation
 {
 public:
   static vtkMultiMaterialVolumeRepresentation* New();
@@ -149,8 +148,8 @@ protected:
   vtkMultiMaterialVolumeRepresentation();
   ~vtkMultiMaterialVolumeRepresentation() override;
 
-  int RequestUpdateExtent(vtkInformation* request, vtkInformationVector** inputVector,
-    vtkInformationVector* outputVector) override;
+  int RequestUpdateExtent(
+    vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   bool AddToView(vtkView* view) override;
   bool RemoveFromView(vtkView* view) override;

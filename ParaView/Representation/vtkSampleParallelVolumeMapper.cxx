@@ -11,7 +11,7 @@
 #include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 
-#include "film.h"  // mmrtm::Film and its moments
+#include "film.h" // mmrtm::Film and its moments
 
 #include <cmath>
 #include <cstdlib>
@@ -99,7 +99,7 @@ void vtkSampleParallelVolumeMapper::ApplyShares()
   this->SetSeed(this->BaseSeed + this->Rank());
   if (n > 1)
     this->SetInteractiveAdjustResolution(false);
-  int threads = this->ThreadsPerProcess;  // 0: all cores
+  int threads = this->ThreadsPerProcess; // 0: all cores
   if (threads == 0 && n > 1)
   {
     // The processes on this machine share its cores (Open MPI and MPICH say
@@ -120,11 +120,11 @@ void vtkSampleParallelVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->Combined = false;
   if (!combine)
   {
-    this->Superclass::Render(ren, vol);  // draws its own samples (DrawFilm below)
+    this->Superclass::Render(ren, vol); // draws its own samples (DrawFilm below)
     ++this->LocalRenders;
     return;
   }
-  this->Superclass::Render(ren, vol);  // DrawFilm runs the collective
+  this->Superclass::Render(ren, vol); // DrawFilm runs the collective
   if (!this->Combined)
   {
     // This process had nothing to draw (an error, an empty viewport): it
@@ -132,7 +132,7 @@ void vtkSampleParallelVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     this->Combine(nullptr);
   }
   ++this->CombinedRenders;
-  this->CombineThisRender = false;  // one render: the next is agreed on anew
+  this->CombineThisRender = false; // one render: the next is agreed on anew
 }
 
 void vtkSampleParallelVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
@@ -159,7 +159,8 @@ void vtkSampleParallelVolumeMapper::WriteLinearImage(const mmrtm::Film& film)
   const int w = film.Width(), h = film.Height();
   vtkNew<vtkImageData> image;
   image->SetDimensions(w, h, 1);
-  auto array = [&](const char* name, int components) {
+  auto array = [&](const char* name, int components)
+  {
     vtkNew<vtkFloatArray> a;
     a->SetName(name);
     a->SetNumberOfComponents(components);
@@ -203,8 +204,7 @@ bool vtkSampleParallelVolumeMapper::Combine(const mmrtm::Film* local)
   const double size[4] = { w, h, -w, -h };
   double extremes[4] = { 0, 0, 0, 0 };
   c->AllReduce(size, extremes, 4, vtkCommunicator::MAX_OP);
-  const bool agree = extremes[0] == -extremes[2] && extremes[1] == -extremes[3] && extremes[0] > 0 &&
-    extremes[1] > 0;
+  const bool agree = extremes[0] == -extremes[2] && extremes[1] == -extremes[3] && extremes[0] > 0 && extremes[1] > 0;
   if (!agree)
   {
     if (local)

@@ -30,9 +30,9 @@
 #define vtkSampleParallelVolumeMapper_h
 
 #include "vtkMultiMaterialVolumeMapper.h"
-#include "mmrtmParaViewRepresentationModule.h"  // for export macro
+#include "mmrtmParaViewRepresentationModule.h" // for export macro
 
-#include <memory>  // for std::unique_ptr
+#include <memory> // for std::unique_ptr
 
 class vtkMultiProcessController;
 
@@ -127,7 +127,7 @@ private:
 
   vtkMultiProcessController* Controller = nullptr;
   bool CombineThisRender = false;
-  bool Combined = false;  // during Render(): the collective has run
+  bool Combined = false; // during Render(): the collective has run
   int TotalSamplesPerRender = 4;
   int TotalMaximumSamples = 256;
   double TotalNoiseTarget = 0.0;

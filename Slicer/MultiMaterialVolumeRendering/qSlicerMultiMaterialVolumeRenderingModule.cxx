@@ -43,7 +43,9 @@ QStringList qSlicerMultiMaterialVolumeRenderingModule::categories() const
 
 QStringList qSlicerMultiMaterialVolumeRenderingModule::dependencies() const
 {
-  return QStringList() << "VolumeRendering" << "Segmentations" << "LayerDM";
+  return QStringList() << "VolumeRendering"
+                       << "Segmentations"
+                       << "LayerDM";
 }
 
 void qSlicerMultiMaterialVolumeRenderingModule::setup()
@@ -59,7 +61,7 @@ void qSlicerMultiMaterialVolumeRenderingModule::setup()
 
 qSlicerAbstractModuleRepresentation* qSlicerMultiMaterialVolumeRenderingModule::createWidgetRepresentation()
 {
-  return nullptr;  // no panel: the Volume Rendering module lists the method
+  return nullptr; // no panel: the Volume Rendering module lists the method
 }
 
 vtkMRMLAbstractLogic* qSlicerMultiMaterialVolumeRenderingModule::createLogic()

@@ -19,7 +19,10 @@ using nlohmann::json;
 namespace {
 
 json Row(const Estimate& e, double exact) {
-  return {{"T", e.mean}, {"se", e.standardError}, {"exact", exact}, {"lookups_per_ray", e.lookupsPerRay},
+  return {{"T", e.mean},
+          {"se", e.standardError},
+          {"exact", exact},
+          {"lookups_per_ray", e.lookupsPerRay},
           {"violations", e.violations}};
 }
 
@@ -62,13 +65,15 @@ json Dense() {
   for (float density : {1.f, 10.f, 100.f, 1000.f, 10000.f})
     for (int leafLevel : {-1, 4}) {
       failure::PathCost cost = failure::DensePathCost(density, RGB(0.8f), 32, leafLevel);
-      out[leafLevel < 0 ? "auto_leaves" : "leaf_level_4"].push_back(
-          {{"density", density}, {"lookups_per_path", cost.lookupsPerPath}, {"real_per_path", cost.realPerPath},
-           {"max_real_per_path", cost.maxRealPerPath}});
+      out[leafLevel < 0 ? "auto_leaves" : "leaf_level_4"].push_back({{"density", density},
+                                                                     {"lookups_per_path", cost.lookupsPerPath},
+                                                                     {"real_per_path", cost.realPerPath},
+                                                                     {"max_real_per_path", cost.maxRealPerPath}});
     }
   for (int bounces : {1, 2, 4, 8, 16, 32, 64}) {
     failure::PathCost cost = failure::DensePathCost(1e4f, RGB(1.f), bounces);
-    out["albedo_one_bounce_limit"].push_back({{"max_bounces", bounces}, {"real_per_path", cost.realPerPath},
+    out["albedo_one_bounce_limit"].push_back({{"max_bounces", bounces},
+                                              {"real_per_path", cost.realPerPath},
                                               {"max_real_per_path", cost.maxRealPerPath},
                                               {"lookups_per_path", cost.lookupsPerPath}});
   }

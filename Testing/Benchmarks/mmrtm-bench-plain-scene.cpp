@@ -27,9 +27,12 @@ int main(int argc, char** argv) {
   std::string volume = std::string(MMRTM_SHARED_DATA_DIR) + "/ct_head_cranium.nrrd";
   int size = 256, spp = 16;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--size") && i + 1 < argc) size = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--spp") && i + 1 < argc) spp = std::atoi(argv[++i]);
-    else volume = argv[i];
+    if (!std::strcmp(argv[i], "--size") && i + 1 < argc)
+      size = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--spp") && i + 1 < argc)
+      spp = std::atoi(argv[++i]);
+    else
+      volume = argv[i];
   }
   try {
     mmrtm::SceneInputs inputs;

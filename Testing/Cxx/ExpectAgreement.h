@@ -40,8 +40,7 @@ inline Agreement ExpectDisagreement(const std::string& what, const ImageEstimate
 // (kExactSigmas + 3.72) standard errors, the check's power (printed, as a
 // fraction of the exact value), fails with probability 1 - 1e-4.
 constexpr double kExactSigmas = 4.5;
-inline void ExpectUnbiased(double mean, double standardError, double exact, const std::string& what,
-                           double slack = 0) {
+inline void ExpectUnbiased(double mean, double standardError, double exact, const std::string& what, double slack = 0) {
   const double power = (kExactSigmas + NormalQuantile(1 - 1e-4)) * standardError / std::fabs(exact);
   std::printf("%s: %.6g +- %.2g against %.6g (z %+.2f; power %.2f %%)\n", what.c_str(), mean, standardError, exact,
               standardError > 0 ? (mean - exact) / standardError : 0.0, 100 * power);

@@ -45,9 +45,15 @@ inline Estimate Transmittance(const SceneView& s, const Ray& ray, Method method,
   for (int i = 0; i < trials; ++i) {
     double T = 0;
     switch (method) {
-      case Method::DeltaTracking: T = DeltaTrack(s, ray, kInfinity, rng, ctr).collided ? 0.0 : 1.0; break;
-      case Method::RatioTracking: T = RatioTrack(s, ray, kInfinity, 1.f, rng, ctr); break;
-      case Method::RayMarching: T = RayMarchTransmittance(s, ray, kInfinity, 1.f, rng, ctr); break;
+      case Method::DeltaTracking:
+        T = DeltaTrack(s, ray, kInfinity, rng, ctr).collided ? 0.0 : 1.0;
+        break;
+      case Method::RatioTracking:
+        T = RatioTrack(s, ray, kInfinity, 1.f, rng, ctr);
+        break;
+      case Method::RayMarching:
+        T = RayMarchTransmittance(s, ray, kInfinity, 1.f, rng, ctr);
+        break;
     }
     sum += T;
     sum2 += T * T;
@@ -113,10 +119,11 @@ inline Case NarrowPeak(float halfWidth, float density, MajorantKind kind, Summar
 inline Case SparseBlock(int n, float density, MajorantKind kind) {
   const int c0 = n / 2 - 1;
   auto inBlock = [c0](int i) { return i == c0 || i == c0 + 1; };
-  Case c{SceneWithTF(test::MakeVolume(n, n, n,
-                                      [&](int i, int j, int k) { return inBlock(i) && inBlock(j) && inBlock(k) ? 1.f : 0.f; }),
-                     CCTF({0.f, 1.f}, {0.f, 1.f}), density, kind),
-         Ray{{-1.f, c0 + 0.5f, c0 + 0.5f}, {1.f, 0.f, 0.f}}, std::exp(-2.0 * density)};
+  Case c{
+      SceneWithTF(test::MakeVolume(
+                      n, n, n, [&](int i, int j, int k) { return inBlock(i) && inBlock(j) && inBlock(k) ? 1.f : 0.f; }),
+                  CCTF({0.f, 1.f}, {0.f, 1.f}), density, kind),
+      Ray{{-1.f, c0 + 0.5f, c0 + 0.5f}, {1.f, 0.f, 0.f}}, std::exp(-2.0 * density)};
   return c;
 }
 
@@ -177,8 +184,9 @@ inline Case AllZeroTF(MajorantKind kind) {
 }
 
 inline Case AllOneTF(MajorantKind kind) {
-  return {SceneWithTF(test::MakeVolume(17, 17, 17, [](int i, int j, int k) { return float((i * 31 + j * 17 + k * 7) % 100); }),
-                      CCTF({0.f, 99.f}, {1.f, 1.f}), 0.1f, kind),
+  return {SceneWithTF(
+              test::MakeVolume(17, 17, 17, [](int i, int j, int k) { return float((i * 31 + j * 17 + k * 7) % 100); }),
+              CCTF({0.f, 99.f}, {1.f, 1.f}), 0.1f, kind),
           Ray{{-2.f, 8.3f, 8.6f}, {1.f, 0.f, 0.f}}, std::exp(-0.1 * 16.0)};
 }
 
@@ -192,12 +200,13 @@ struct PathCost {
 // Paths from a camera into a ball of density `density` (smooth edge, 1 mm
 // voxels), rendered one path at a time to see each path's own count.
 inline PathCost DensePathCost(float density, RGB albedo, int maxBounces, int leafLevel = -1) {
-  Scene scene = test::MakeMediumScene(test::MakeVolume(33, 33, 33,
-                                                       [](int i, int j, int k) {
-                                                         float r = std::sqrt(float((i - 16) * (i - 16) + (j - 16) * (j - 16) + (k - 16) * (k - 16)));
-                                                         return std::clamp(12.f - r, 0.f, 1.f);
-                                                       }),
-                                      density, albedo);
+  Scene scene = test::MakeMediumScene(
+      test::MakeVolume(33, 33, 33,
+                       [](int i, int j, int k) {
+                         float r = std::sqrt(float((i - 16) * (i - 16) + (j - 16) * (j - 16) + (k - 16) * (k - 16)));
+                         return std::clamp(12.f - r, 0.f, 1.f);
+                       }),
+      density, albedo);
   scene.environment = EnvironmentMap::Constant(RGB(1.f));
   scene.render.integrator.maxBounces = maxBounces;
   scene.render.accelerator.grid.leafLevel = leafLevel;

@@ -53,8 +53,7 @@ inline ImageEstimate EstimateFromReplicates(int replicates, uint64_t firstSeed,
 // `replicates` renders of `view` with `spp` samples each, seeds firstSeed,
 // firstSeed + 1, ...; the work of all of them is added to `counters`.
 inline ImageEstimate RenderReplicates(SceneView view, int replicates, int spp, uint64_t firstSeed,
-                                      TraceCounters* counters = nullptr, Film* combined = nullptr,
-                                      int threads = 2) {
+                                      TraceCounters* counters = nullptr, Film* combined = nullptr, int threads = 2) {
   return EstimateFromReplicates(
       replicates, firstSeed,
       [&](uint64_t seed) {

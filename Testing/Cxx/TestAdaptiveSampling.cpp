@@ -20,9 +20,9 @@ namespace mmrtm {
 namespace {
 
 Scene MakeScene() {
-  Scene scene = test::MakeMediumScene(
-      test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }), 1.f,
-      RGB(0.9f, 0.7f, 0.5f), 0.3f);
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }),
+                            1.f, RGB(0.9f, 0.7f, 0.5f), 0.3f);
   scene.materials[0].base[6] = 0.5f;
   scene.environment = EnvironmentMap::DefaultSky();
   scene.render.integrator.shadowExtinctionScale = 1.f;
@@ -70,8 +70,7 @@ TEST(AdaptiveSampling, WeightsComeFromTheNeighboursOnly) {
   FilmView view = pilot.View();
   for (int y = 0; y < 5; ++y)
     for (int x = 0; x < 5; ++x)
-      for (uint32_t n = 1; n <= 4; ++n)
-        view.AddSample(x, y, RGB(x == 2 && y == 2 ? (float)(n % 2) : 0.5f), 1.f, n);
+      for (uint32_t n = 1; n <= 4; ++n) view.AddSample(x, y, RGB(x == 2 && y == 2 ? (float)(n % 2) : 0.5f), 1.f, n);
   pilot.AddSamples(4);
   const std::vector<float> w = AdaptiveSampleWeights(pilot);
   EXPECT_EQ(w[2 * 5 + 2], 0.f);

@@ -16,7 +16,8 @@ namespace {
 Scene TwoComponentScene() {
   Scene scene = test::MakeMediumScene(test::MakeVolume(16, 16, 16, [](int i, int, int) { return i / 15.f; }), 1.f,
                                       RGB(1.f, 0.f, 0.f));
-  scene.proxies.push_back(test::MakeVolume(16, 16, 16, [](int, int j, int) { return j / 15.f; }, 1.f, "second"));
+  scene.proxies.push_back(test::MakeVolume(
+      16, 16, 16, [](int, int j, int) { return j / 15.f; }, 1.f, "second"));
   TransferFunctionDesc tf = test::IdentityCCTF(0.f, 1.f, 1);
   scene.tfs.push_back(tf);
   MaterialDesc blue = scene.materials[0];

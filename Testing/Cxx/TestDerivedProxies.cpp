@@ -50,7 +50,11 @@ TEST(DerivedProxies, GradientOfARampOnAnObliqueGrid) {
   const Affine3 grid = ObliqueGrid();
   const Vec3 a{3.f, -2.f, 6.f};  // |a| = 7 per mm
   HostVolume ramp = MakeTyped<float>(
-      {7, 6, 5}, [&](int i, int j, int k) { return Dot(a, grid.ApplyPoint({float(i), float(j), float(k)})); }, grid);
+      {7, 6, 5},
+      [&](int i, int j, int k) {
+        return Dot(a, grid.ApplyPoint({float(i), float(j), float(k)}));
+      },
+      grid);
   HostVolume g = GradientMagnitudeProxy(ramp, "grad");
   EXPECT_EQ(g.name, "grad");
   EXPECT_EQ(g.type, VoxelType::Float32);
@@ -78,7 +82,7 @@ TEST(DerivedProxies, GradientOfIntegerRampsUsesTheSmallestType) {
     // Ramp along y (the middle axis), 3 voxels long; x and z are 2 and 1 thick.
     auto f = [&](int, int j, int) { return c.slopePerVoxel * j - (c.sourceType == VoxelType::Int16 ? 300 : 0); };
     const Affine3 grid = Grid({0, 0, 0}, {1.5, c.spacing, 2});
-    HostVolume v = c.sourceType == VoxelType::UInt8    ? MakeTyped<uint8_t>({2, 3, 1}, f, grid)
+    HostVolume v = c.sourceType == VoxelType::UInt8   ? MakeTyped<uint8_t>({2, 3, 1}, f, grid)
                    : c.sourceType == VoxelType::Int16 ? MakeTyped<int16_t>({2, 3, 1}, f, grid)
                                                       : MakeTyped<uint16_t>({2, 3, 1}, f, grid);
     HostVolume g = GradientMagnitudeProxy(v, "grad");
@@ -89,22 +93,27 @@ TEST(DerivedProxies, GradientOfIntegerRampsUsesTheSmallestType) {
 
 TEST(DerivedProxies, GradientIsRoundedForIntegerSources) {
   // v = i with spacing 3: 1/3 per mm rounds to 0; v = 2i: 2/3 rounds to 1.
-  HostVolume v = MakeTyped<uint8_t>({4, 2, 2}, [](int i, int, int) { return i; }, Grid({0, 0, 0}, {3, 1, 1}));
+  HostVolume v = MakeTyped<uint8_t>(
+      {4, 2, 2}, [](int i, int, int) { return i; }, Grid({0, 0, 0}, {3, 1, 1}));
   EXPECT_EQ(At(GradientMagnitudeProxy(v, "g"), 1, 0, 0), 0.f);
-  v = MakeTyped<uint8_t>({4, 2, 2}, [](int i, int, int) { return 2 * i; }, Grid({0, 0, 0}, {3, 1, 1}));
+  v = MakeTyped<uint8_t>(
+      {4, 2, 2}, [](int i, int, int) { return 2 * i; }, Grid({0, 0, 0}, {3, 1, 1}));
   EXPECT_EQ(At(GradientMagnitudeProxy(v, "g"), 1, 0, 0), 1.f);
 }
 
 TEST(DerivedProxies, SmoothingAConstantIsConstant) {
-  HostVolume f = MakeTyped<float>({9, 7, 5}, [](int, int, int) { return 2.5; }, ObliqueGrid());
+  HostVolume f = MakeTyped<float>(
+      {9, 7, 5}, [](int, int, int) { return 2.5; }, ObliqueGrid());
   HostVolume s = SmoothedProxy(f, 1.7f, "smooth");
   EXPECT_EQ(s.type, VoxelType::Float32);
   ForEachVoxel(s, [&](int i, int j, int k) { ASSERT_NEAR(At(s, i, j, k), 2.5f, 1e-5f); });
-  HostVolume ct = MakeTyped<int16_t>({6, 6, 6}, [](int, int, int) { return -500; }, Grid({0, 0, 0}, {0.7, 0.7, 2}));
+  HostVolume ct = MakeTyped<int16_t>(
+      {6, 6, 6}, [](int, int, int) { return -500; }, Grid({0, 0, 0}, {0.7, 0.7, 2}));
   s = SmoothedProxy(ct, 3.f, "smooth");
   EXPECT_EQ(s.type, VoxelType::Int16);
   ForEachVoxel(s, [&](int i, int j, int k) { ASSERT_EQ(At(s, i, j, k), -500.f); });
-  HostVolume u = MakeTyped<uint16_t>({6, 6, 6}, [](int, int, int) { return 7; }, Grid({0, 0, 0}, {1, 1, 1}));
+  HostVolume u = MakeTyped<uint16_t>(
+      {6, 6, 6}, [](int, int, int) { return 7; }, Grid({0, 0, 0}, {1, 1, 1}));
   s = SmoothedProxy(u, 0.4f, "smooth");
   EXPECT_EQ(s.type, VoxelType::UInt8);  // the smallest type that holds 7
   ForEachVoxel(s, [&](int i, int j, int k) { ASSERT_EQ(At(s, i, j, k), 7.f); });
@@ -115,8 +124,9 @@ TEST(DerivedProxies, SmoothingSigmaIsInMillimetresPerAxis) {
   // of a neighbour to the centre along axis a is exp(-1 / (2 sigma_a^2))
   // with sigma_a = sigma_mm / spacing_a voxels.
   const int n = 27, c = 13;  // the x kernel (radius 12) fits inside
-  HostVolume impulse = MakeTyped<float>({n, n, n}, [&](int i, int j, int k) { return i == c && j == c && k == c ? 1000 : 0; },
-                                        Grid({0, 0, 0}, {0.5, 1, 2}));
+  HostVolume impulse = MakeTyped<float>(
+      {n, n, n}, [&](int i, int j, int k) { return i == c && j == c && k == c ? 1000 : 0; },
+      Grid({0, 0, 0}, {0.5, 1, 2}));
   HostVolume s = SmoothedProxy(impulse, 2.f, "smooth");
   const float centre = At(s, c, c, c);
   const double sigma[3] = {4, 2, 1};
@@ -133,8 +143,8 @@ TEST(DerivedProxies, SmoothingSigmaIsInMillimetresPerAxis) {
 }
 
 TEST(DerivedProxies, OpacityFollowsTheTransferFunction) {
-  HostVolume v = MakeTyped<float>({16, 16, 1}, [](int i, int j, int) { return 16 * j + i - 0.25; },
-                                  Grid({0, 0, 0}, {1, 1, 1}));
+  HostVolume v = MakeTyped<float>(
+      {16, 16, 1}, [](int i, int j, int) { return 16 * j + i - 0.25; }, Grid({0, 0, 0}, {1, 1, 1}));
   HostVolume o = OpacityProxy(v, {{50, 0}, {150, 1}, {200, 0.5}}, "opacity");
   EXPECT_EQ(o.type, VoxelType::UInt8);
   EXPECT_EQ(o.interpolation, Interpolation::Trilinear);
@@ -149,14 +159,18 @@ TEST(DerivedProxies, OpacityFollowsTheTransferFunction) {
 }
 
 TEST(DerivedProxies, BadParametersThrow) {
-  HostVolume v = MakeTyped<uint8_t>({4, 4, 4}, [](int i, int, int) { return i; }, Grid({0, 0, 0}, {1, 1, 1}));
+  HostVolume v = MakeTyped<uint8_t>(
+      {4, 4, 4}, [](int i, int, int) { return i; }, Grid({0, 0, 0}, {1, 1, 1}));
   for (float sigma : {0.f, -1.f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
     const std::string m = ErrorOf([&] { SmoothedProxy(v, sigma, "smooth"); });
     EXPECT_NE(m.find("smooth: the smoothing sigma must be a positive number of mm"), std::string::npos) << m;
   }
-  EXPECT_NE(ErrorOf([&] { OpacityProxy(v, {}, "op"); }).find("op: an opacity transfer function needs at least one point"),
-            std::string::npos);
-  EXPECT_NE(ErrorOf([&] { OpacityProxy(v, {{10, 0}, {5, 1}}, "op"); }).find("op: opacity point 1 [5, 1]: values must not decrease"),
+  EXPECT_NE(
+      ErrorOf([&] { OpacityProxy(v, {}, "op"); }).find("op: an opacity transfer function needs at least one point"),
+      std::string::npos);
+  EXPECT_NE(ErrorOf([&] {
+              OpacityProxy(v, {{10, 0}, {5, 1}}, "op");
+            }).find("op: opacity point 1 [5, 1]: values must not decrease"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { OpacityProxy(v, {{10, 1.5f}}, "op"); }).find("opacity must be in 0..1"), std::string::npos);
   HostVolume broken = v;
@@ -172,14 +186,15 @@ namespace {
 SceneInputs RampInputs() {
   // uint8 ramp of 10 per voxel along x, 0.5 mm voxels: 20 per mm.
   SceneInputs in;
-  in.volumes["scalars"] =
-      MakeTyped<uint8_t>({10, 6, 4}, [](int i, int, int) { return 10 * i; }, Grid({0, 0, 0}, {0.5, 0.8, 1.2}));
+  in.volumes["scalars"] = MakeTyped<uint8_t>(
+      {10, 6, 4}, [](int i, int, int) { return 10 * i; }, Grid({0, 0, 0}, {0.5, 0.8, 1.2}));
   return in;
 }
 
 // A scene whose one material's density reads `proxy`.
 json SceneReading(const std::string& proxy, const json& volumes) {
-  json doc = json::parse(R"({"materials": {"m": {"tfs": {"density": [{"type": "cctf", "points": [[0, 0], [255, 1]]}]}}}})");
+  json doc =
+      json::parse(R"({"materials": {"m": {"tfs": {"density": [{"type": "cctf", "points": [[0, 0], [255, 1]]}]}}}})");
   doc["materials"]["m"]["tfs"]["density"][0]["proxy"] = proxy;
   doc["volumes"] = volumes;
   return doc;
@@ -197,8 +212,9 @@ std::string SceneError(const json& doc, SceneInputs in = RampInputs()) {
 }  // namespace
 
 TEST(DerivedProxies, SceneBuildsAReadGradientProxy) {
-  Scene s = SceneFromJson(SceneReading("grad", json::parse(R"({"grad": {"derived": "gradient_magnitude", "from": "scalars"}})")),
-                          RampInputs());
+  Scene s = SceneFromJson(
+      SceneReading("grad", json::parse(R"({"grad": {"derived": "gradient_magnitude", "from": "scalars"}})")),
+      RampInputs());
   const int g = s.ProxyIndex("grad");
   ASSERT_EQ(g, 1);
   const HostVolume& grad = s.proxies[g];
@@ -211,15 +227,19 @@ TEST(DerivedProxies, SceneBuildsAReadGradientProxy) {
 
 TEST(DerivedProxies, SceneBuildsSmoothedAndOpacityProxies) {
   SceneInputs in;
-  in.volumes["scalars"] = MakeTyped<float>({8, 8, 8}, [](int, int, int) { return 3.25; }, ObliqueGrid());
-  Scene s = SceneFromJson(SceneReading("smooth", json::parse(R"({"smooth": {"derived": "smoothed", "from": "scalars", "sigma_mm": 1.0}})")),
-                          in);
+  in.volumes["scalars"] = MakeTyped<float>(
+      {8, 8, 8}, [](int, int, int) { return 3.25; }, ObliqueGrid());
+  Scene s = SceneFromJson(
+      SceneReading("smooth", json::parse(R"({"smooth": {"derived": "smoothed", "from": "scalars", "sigma_mm": 1.0}})")),
+      in);
   const HostVolume& smooth = s.proxies[s.ProxyIndex("smooth")];
   EXPECT_EQ(smooth.type, VoxelType::Float32);
   ForEachVoxel(smooth, [&](int i, int j, int k) { ASSERT_NEAR(At(smooth, i, j, k), 3.25f, 1e-5f); });
 
-  s = SceneFromJson(SceneReading("op", json::parse(R"({"op": {"derived": "opacity", "from": "scalars", "points": [[0, 0], [80, 0.4]]}})")),
-                    RampInputs());
+  s = SceneFromJson(
+      SceneReading("op",
+                   json::parse(R"({"op": {"derived": "opacity", "from": "scalars", "points": [[0, 0], [80, 0.4]]}})")),
+      RampInputs());
   const HostVolume& op = s.proxies[s.ProxyIndex("op")];
   EXPECT_EQ(op.type, VoxelType::UInt8);
   ForEachVoxel(op, [&](int i, int j, int k) {
@@ -229,7 +249,8 @@ TEST(DerivedProxies, SceneBuildsSmoothedAndOpacityProxies) {
 
 TEST(DerivedProxies, SceneBuildsADerivedGradientProxy) {
   // Read only as the surface normal's proxy: kept and computed.
-  json doc = SceneReading("scalars", json::parse(R"({"smooth": {"derived": "smoothed", "from": "scalars", "sigma_mm": 2}})"));
+  json doc =
+      SceneReading("scalars", json::parse(R"({"smooth": {"derived": "smoothed", "from": "scalars", "sigma_mm": 2}})"));
   doc["gradient_proxy"] = "smooth";
   Scene s = SceneFromJson(doc, RampInputs());
   ASSERT_GE(s.ProxyIndex("smooth"), 0);
@@ -276,13 +297,16 @@ TEST(DerivedProxies, SceneErrorsNameTheJsonPath) {
        "volumes.s.sigma_mm: must be a positive number of mm"},
       {R"({"s": {"derived": "smoothed", "from": "scalars", "sigma_mm": -2}})",
        "volumes.s.sigma_mm: must be a positive number of mm"},
-      {R"({"s": {"derived": "smoothed", "from": "scalars", "sigma_mm": "big"}})", "volumes.s.sigma_mm: expected a number"},
+      {R"({"s": {"derived": "smoothed", "from": "scalars", "sigma_mm": "big"}})",
+       "volumes.s.sigma_mm: expected a number"},
       {R"({"s": {"derived": "smoothed", "from": "scalars"}})", "volumes.s: a smoothed volume needs sigma_mm"},
       {R"({"o": {"derived": "opacity", "from": "scalars"}})", "volumes.o.points: an opacity volume needs"},
-      {R"({"o": {"derived": "opacity", "from": "scalars", "points": []}})", "volumes.o.points: an opacity volume needs"},
+      {R"({"o": {"derived": "opacity", "from": "scalars", "points": []}})",
+       "volumes.o.points: an opacity volume needs"},
       {R"({"o": {"derived": "opacity", "from": "scalars", "points": [[10, 0], [5, 1]]}})",
        "volumes.o.points[1]: values must be in ascending order"},
-      {R"({"o": {"derived": "opacity", "from": "scalars", "points": [[10, 2]]}})", "volumes.o.points[0]: opacity must be in 0..1"},
+      {R"({"o": {"derived": "opacity", "from": "scalars", "points": [[10, 2]]}})",
+       "volumes.o.points[0]: opacity must be in 0..1"},
       {R"({"o": {"derived": "opacity", "from": "scalars", "points": [[10, 0, 1]]}})",
        "volumes.o.points[0]: expected [value, opacity]"},
   };

@@ -27,9 +27,9 @@ std::vector<float> Render(Scene& scene, int threads, uint64_t seed, int passes, 
 }
 
 Scene MakeScene() {
-  Scene scene = test::MakeMediumScene(
-      test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }), 1.f,
-      RGB(0.9f, 0.7f, 0.5f), 0.3f);
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }),
+                            1.f, RGB(0.9f, 0.7f, 0.5f), 0.3f);
   scene.materials[0].base[6] = 0.5f;  // half the collisions scatter on the surface BSDF
   scene.environment = EnvironmentMap::DefaultSky();
   Light sun;
@@ -62,7 +62,8 @@ TEST(Determinism, PlainScenePathEqualsTheGeneralPath) {
   EXPECT_EQ(0, std::memcmp(shortest.data(), general.data(), shortest.size() * sizeof(float)));
   // A second material, chosen by an MDPTF over a label proxy, makes it not plain.
   Scene labelled = MakeScene();
-  labelled.proxies.push_back(test::MakeVolume(12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
+  labelled.proxies.push_back(test::MakeVolume(
+      12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
   labelled.materials.push_back(labelled.materials[0]);
   labelled.materials[1].name = "other";
   TransferFunctionDesc selector;

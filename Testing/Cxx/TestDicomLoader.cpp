@@ -144,10 +144,12 @@ void ExpectGeometryFromHeaders(const HostVolume& v, const std::string& folder) {
   ExpectWorld(v, {0, 0, (float)(v.dims[2] - 1)}, last.position);
   const auto& o = first.orientation;
   const double dx = first.pixelSpacing[1], dy = first.pixelSpacing[0];
-  ExpectWorld(v, {10, 0, 0}, {first.position[0] + 10 * dx * o[0], first.position[1] + 10 * dx * o[1],
-                              first.position[2] + 10 * dx * o[2]});
-  ExpectWorld(v, {0, 10, 0}, {first.position[0] + 10 * dy * o[3], first.position[1] + 10 * dy * o[4],
-                              first.position[2] + 10 * dy * o[5]});
+  ExpectWorld(
+      v, {10, 0, 0},
+      {first.position[0] + 10 * dx * o[0], first.position[1] + 10 * dx * o[1], first.position[2] + 10 * dx * o[2]});
+  ExpectWorld(
+      v, {0, 10, 0},
+      {first.position[0] + 10 * dy * o[3], first.position[1] + 10 * dy * o[4], first.position[2] + 10 * dy * o[5]});
 }
 
 // Loads with warnings collected instead of printed.
@@ -294,8 +296,9 @@ TEST(DicomLoader, GantryTiltBecomesAShearWithAWarning) {
   EXPECT_EQ(v.dims[2], (int)headers.size());
   ExpectWorld(v, {0, 0, 0}, positions.front());
   ExpectWorld(v, {0, 0, (float)(v.dims[2] - 1)}, positions.back());
-  ExpectWorld(v, {7, 9, 10}, {positions[10][0] + 7 * headers[0].second.pixelSpacing[1],
-                              positions[10][1] + 9 * headers[0].second.pixelSpacing[0], positions[10][2]});
+  ExpectWorld(v, {7, 9, 10},
+              {positions[10][0] + 7 * headers[0].second.pixelSpacing[1],
+               positions[10][1] + 9 * headers[0].second.pixelSpacing[0], positions[10][2]});
   const HostVolume untilted = LoadVolume(Data("ct_chest_dicom"));
   for (int k : {0, 15})
     for (auto [i, j] : {std::pair{256, 256}, std::pair{100, 300}})
@@ -315,8 +318,8 @@ TEST(DicomLoader, TwoSeriesInOneFolder) {
   EXPECT_TRUE(Contains(warnings, "CT Body 3.0"));
   // Another by its description (case-insensitive) or UID.
   EXPECT_EQ(LoadCollecting(folder, warnings, "ct body 3.0").dims[2], 20);
-  EXPECT_EQ(LoadCollecting(folder, warnings, "1.3.6.1.4.1.14519.5.2.1.6279.6001.154677396354641150280013275227").dims[2],
-            92);
+  EXPECT_EQ(
+      LoadCollecting(folder, warnings, "1.3.6.1.4.1.14519.5.2.1.6279.6001.154677396354641150280013275227").dims[2], 92);
   ExpectInputError(folder, "no series with the UID or description \"nonsense\"", "nonsense");
 }
 
@@ -385,7 +388,8 @@ std::pair<double, int64_t> MeanUnderLabel(const HostVolume& ct, const HostVolume
 // they do not.
 TEST(DicomLoader, LabelMapAlignsToTheSeriesInWorldSpace) {
   const HostVolume ct = LoadVolume(Data("ct_abdomen_dicom_j2k"));
-  const HostVolume raw = LoadVolume(Data("ct_abdomen_dicom_j2k_labels.nii.gz"), "labels", mmrtm::Interpolation::Nearest);
+  const HostVolume raw =
+      LoadVolume(Data("ct_abdomen_dicom_j2k_labels.nii.gz"), "labels", mmrtm::Interpolation::Nearest);
   ASSERT_EQ(raw.dims, ct.dims);
   bool resampled = false;
   const HostVolume aligned = mmrtm::AlignLabelsToVolume(raw, ct, &resampled);

@@ -88,8 +88,8 @@ TEST(VeryDenseMedia, LookupsGrowNoFasterThanTheDensity) {
   // part empty, part dense, tracking takes ~majorant x empty length steps.
   // They must stay bounded by that (linear in the density), not explode.
   failure::PathCost d2 = failure::DensePathCost(1e2f, RGB(0.8f), 32), d4 = failure::DensePathCost(1e4f, RGB(0.8f), 32);
-  std::printf("lookups per path: density 1e2 %.1f, 1e4 %.1f; real collisions per path %.2f, %.2f\n",
-              d2.lookupsPerPath, d4.lookupsPerPath, d2.realPerPath, d4.realPerPath);
+  std::printf("lookups per path: density 1e2 %.1f, 1e4 %.1f; real collisions per path %.2f, %.2f\n", d2.lookupsPerPath,
+              d4.lookupsPerPath, d2.realPerPath, d4.realPerPath);
   EXPECT_LT(d4.lookupsPerPath, 100.0 * 1.1 * d2.lookupsPerPath);
   EXPECT_LT(d4.realPerPath, 4.0);
 }
@@ -104,8 +104,8 @@ TEST(GrazingRays, AlongASliceOnANodeFace) {
       for (Method m : {Method::DeltaTracking, Method::RatioTracking}) {
         Estimate e = Measure(c, m);
         test::ExpectUnbiased(e.mean, e.standardError, c.exact,
-                             "sheet at z " + std::to_string(z) + ", kind " + std::to_string((int)kind) +
-                                 ", method " + std::to_string((int)m),
+                             "sheet at z " + std::to_string(z) + ", kind " + std::to_string((int)kind) + ", method " +
+                                 std::to_string((int)m),
                              1e-6);
         EXPECT_EQ(e.violations, 0u);
       }

@@ -55,8 +55,7 @@ TEST(FilmMoments, CombinedFilmIsTheFilmOfAllSamples) {
     for (int x = 0; x < w; ++x) {
       for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(all.Mean(x, y)[c], combined.Mean(x, y)[c], 1e-4f);
-        EXPECT_NEAR(all.VarianceOfMean(x, y)[c], combined.VarianceOfMean(x, y)[c],
-                    1e-4f * all.VarianceOfMean(x, y)[c]);
+        EXPECT_NEAR(all.VarianceOfMean(x, y)[c], combined.VarianceOfMean(x, y)[c], 1e-4f * all.VarianceOfMean(x, y)[c]);
         EXPECT_GT(combined.VarianceOfMean(x, y)[c], 0.f);
       }
       EXPECT_NEAR(all.Alpha(x, y), combined.Alpha(x, y), 1e-5f);
@@ -112,8 +111,7 @@ TEST(FilmNoise, IsTheLuminanceStandardErrorForIndependentSamples) {
       return correlated ? RGB(a, 0.5f * a, 2.f * a) : RGB(a, u(rng), u(rng));
     });
     // Var of one sample's luminance, then of a pixel's mean of 16.
-    const double sampleVar =
-        correlated ? std::pow(wr + 0.5 * wg + 2 * wb, 2) : wr * wr + wg * wg + wb * wb;
+    const double sampleVar = correlated ? std::pow(wr + 0.5 * wg + 2 * wb, 2) : wr * wr + wg * wg + wb * wb;
     const double meanLum = correlated ? wr + 0.5 * wg + 2 * wb : wr + wg + wb;
     const double trueVar = sampleVar / samples;
     const NoiseEstimate noise = film.Noise();
@@ -173,9 +171,9 @@ TEST(FilmNoise, NeedsASampleInEachReplicate) {
 }
 
 TEST(FilmMoments, TwoSeedsCombinedAgreeWithASerialRenderOfTwiceTheSamples) {
-  Scene scene = test::MakeMediumScene(
-      test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }), 1.f,
-      RGB(0.9f, 0.7f, 0.5f), 0.3f);
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }),
+                            1.f, RGB(0.9f, 0.7f, 0.5f), 0.3f);
   scene.environment = EnvironmentMap::DefaultSky();
   // Independent samples: the z-scores below take each pixel's sample
   // variance for its spread, which stratified (Sobol') samples overstate

@@ -20,9 +20,10 @@
 namespace mmrtm {
 namespace {
 
-#define SKIP_WITHOUT_DEVICE()                                                                           \
-  if (!CudaDevice().available) GTEST_SKIP() << "no CUDA device here (" << CudaDevice().reason           \
-                                            << "); run `ctest -L gpu` on a GPU machine (Documentation/gpu.md)"
+#define SKIP_WITHOUT_DEVICE()                                    \
+  if (!CudaDevice().available)                                   \
+  GTEST_SKIP() << "no CUDA device here (" << CudaDevice().reason \
+               << "); run `ctest -L gpu` on a GPU machine (Documentation/gpu.md)"
 
 Scene HeadScene(uint64_t seed) {
   nlohmann::json doc = ReadJsonFile(std::string(MMRTM_DATA_DIR) + "/presets/ct-bone.json");

@@ -73,9 +73,10 @@ TEST(ImageAgreement, FalseFailuresAndPowerAreAsStated) {
     for (double z : r.globalZ) sumZ2 += z * z / 3;
     power += r.power / trials;
   }
-  std::printf("%d trials at false-failure level %.3f: %d failed (global %d, blocks %d); mean global z^2 %.3f; "
-              "mean power %.2f %%\n",
-              trials, options.falseFailure, failures, globalFailures, blockFailures, sumZ2 / trials, 100 * power);
+  std::printf(
+      "%d trials at false-failure level %.3f: %d failed (global %d, blocks %d); mean global z^2 %.3f; "
+      "mean power %.2f %%\n",
+      trials, options.falseFailure, failures, globalFailures, blockFailures, sumZ2 / trials, 100 * power);
   // Binomial(3000, 0.01): 30 +- 5.4; the bounds are over 3.5 standard deviations out.
   EXPECT_GE(failures, 11);
   EXPECT_LE(failures, 50);

@@ -43,8 +43,8 @@ struct Rendered {
 
 // The ct-bone preset on `volume` (a file or folder in ../shared/data),
 // 128 x 128, `replicates` renders of `spp` samples from seed firstSeed on.
-Rendered RenderBonePreset(const std::string& volume, const nlohmann::json& camera, uint64_t firstSeed,
-                          int replicates, int spp, float albedoScale = 1.f) {
+Rendered RenderBonePreset(const std::string& volume, const nlohmann::json& camera, uint64_t firstSeed, int replicates,
+                          int spp, float albedoScale = 1.f) {
   nlohmann::json doc = ReadJsonFile(std::string(MMRTM_DATA_DIR) + "/presets/ct-bone.json");
   doc["render"].merge_patch({{"width", 128}, {"height", 128}});
   for (auto& c : doc["materials"]["bone"]["albedo"]) c = c.get<float>() * albedoScale;
@@ -74,10 +74,8 @@ void WriteBaseline(const std::string& baseline, const Rendered& r) {
   WritePFM(baseline + ".pfm", Channels(r.estimate, r.estimate.mean));
   WritePFM(baseline + "_variance.pfm", Channels(r.estimate, r.estimate.variance));
   WritePNG(baseline + ".png", r.estimate.width, r.estimate.height, 3, r.png);
-  std::ofstream(baseline + ".json") << nlohmann::json{{"replicates", kBaselineReplicates},
-                                                      {"samples_per_replicate", kBaselineSpp}}
-                                           .dump(2)
-                                    << "\n";
+  std::ofstream(baseline + ".json")
+      << nlohmann::json{{"replicates", kBaselineReplicates}, {"samples_per_replicate", kBaselineSpp}}.dump(2) << "\n";
 }
 
 test::ImageEstimate ReadBaseline(const std::string& baseline) {
@@ -158,8 +156,7 @@ TEST(ImageCT, ChestDicomSeriesMatchesBaseline) {
 // the image made 2 % darker.
 TEST(ImageCT, ComparisonSeesSmallBiases) {
   const test::ImageEstimate baseline = ReadBaseline(BaselinePath("ct_head_cranium_bone"));
-  test::ExpectDisagreement("bone albedo x0.97", AgainstBaseline(RenderCranium(99, 0.97f).estimate, baseline),
-                           baseline);
+  test::ExpectDisagreement("bone albedo x0.97", AgainstBaseline(RenderCranium(99, 0.97f).estimate, baseline), baseline);
   test::ExpectDisagreement("2 % darker", AgainstBaseline(test::Scaled(RenderCranium(199).estimate, 0.98), baseline),
                            baseline);
 }

@@ -18,7 +18,8 @@ namespace {
 double LabelOf(int i, int j, int k) { return 1 + i + 7 * j + 31 * k; }
 
 HostVolume Reference() {
-  return MakeTyped<float>({6, 5, 4}, [](int i, int, int) { return i; }, Grid({10, 20, 30}, {1, 2, 3}), "scalars");
+  return MakeTyped<float>(
+      {6, 5, 4}, [](int i, int, int) { return i; }, Grid({10, 20, 30}, {1, 2, 3}), "scalars");
 }
 
 HostVolume Labels(std::array<int, 3> dims, const std::function<double(int, int, int)>& f, const Affine3& grid) {
@@ -80,12 +81,12 @@ TEST(LabelAlignment, MirroredGridAlignsExactly) {
 TEST(LabelAlignment, RotatedGridAlignsExactly) {
   // Reference axes turned 90 degrees about z (a direction matrix whose
   // columns are permuted axes): reference (i, j, k) lies at world (-j, i, 2k).
-  const HostVolume ref = MakeTyped<int16_t>({4, 6, 3}, [](int, int, int) { return 0; },
-                                            Grid({0, 0, 0}, {1, 1, 2}, {0, -1, 0, 1, 0, 0, 0, 0, 1}));
+  const HostVolume ref = MakeTyped<int16_t>(
+      {4, 6, 3}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 2}, {0, -1, 0, 1, 0, 0, 0, 0, 1}));
   // Axis-aligned labels over the same box: label (x, y, k) lies at world
   // (x - 5, y, 2k), which is reference (y, 5 - x, k).
-  HostVolume labels = Labels({6, 4, 3}, [](int x, int y, int k) { return LabelOf(y, 5 - x, k); },
-                             Grid({-5, 0, 0}, {1, 1, 2}));
+  HostVolume labels = Labels(
+      {6, 4, 3}, [](int x, int y, int k) { return LabelOf(y, 5 - x, k); }, Grid({-5, 0, 0}, {1, 1, 2}));
   bool resampled = false;
   HostVolume out = AlignLabelsToVolume(labels, ref, &resampled);
   EXPECT_TRUE(resampled);
@@ -93,11 +94,12 @@ TEST(LabelAlignment, RotatedGridAlignsExactly) {
 }
 
 TEST(LabelAlignment, HalfResolutionUpsamples) {
-  const HostVolume ref = MakeTyped<float>({8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}));
+  const HostVolume ref = MakeTyped<float>(
+      {8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}));
   // Each label voxel covers 2x2x2 reference voxels: its centre is at the
   // middle of their block, so no reference centre lies on a boundary.
-  HostVolume labels = MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({0.5, 0.5, 0.5}, {2, 2, 2}), "labels",
-                                         Interpolation::Nearest);
+  HostVolume labels =
+      MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({0.5, 0.5, 0.5}, {2, 2, 2}), "labels", Interpolation::Nearest);
   bool resampled = false;
   HostVolume out = AlignLabelsToVolume(labels, ref, &resampled);
   EXPECT_TRUE(resampled);
@@ -107,7 +109,8 @@ TEST(LabelAlignment, HalfResolutionUpsamples) {
 }
 
 TEST(LabelAlignment, VoxelsOutsideTheLabelMapAreBackground) {
-  const HostVolume ref = MakeTyped<float>({8, 6, 4}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}));
+  const HostVolume ref = MakeTyped<float>(
+      {8, 6, 4}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}));
   // Covers reference x 3..7 only (and y 0..5, z 0..3), shifted by a fraction of a voxel.
   HostVolume labels = Labels({6, 6, 4}, LabelOf, Grid({3.2, 0, 0}, {1, 1, 1}));
   HostVolume out = AlignLabelsToVolume(labels, ref);
@@ -124,9 +127,11 @@ TEST(LabelAlignment, FarAwayLabelMapThrows) {
 }
 
 TEST(LabelAlignment, NoSurvivingLabelThrows) {
-  const HostVolume ref = MakeTyped<float>({8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}));
+  const HostVolume ref = MakeTyped<float>(
+      {8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}));
   // Overlaps in x 4..7, but its labels are all beyond x = 8.
-  HostVolume labels = Labels({10, 8, 8}, [](int i, int, int) { return i >= 5 ? 3 : 0; }, Grid({4, 0, 0}, {1, 1, 1}));
+  HostVolume labels = Labels(
+      {10, 8, 8}, [](int i, int, int) { return i >= 5 ? 3 : 0; }, Grid({4, 0, 0}, {1, 1, 1}));
   const std::string message = ErrorOf(labels, ref);
   EXPECT_NE(message.find("labels.nrrd: no label is left"), std::string::npos) << message;
   EXPECT_NE(message.find("scalars.nrrd"), std::string::npos) << message;
@@ -138,10 +143,10 @@ TEST(LabelAlignment, SceneResamplesReadLabelMaps) {
     "materials": {"m": {"tfs": {"density": [{"type": "cdptf", "proxy": "labels", "points": [[1, 1]]}]}}}
   })");
   SceneInputs in;
-  in.volumes["scalars"] =
-      MakeTyped<float>({8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}), "scalars");
-  in.volumes["labels"] = MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({0.5, 0.5, 0.5}, {2, 2, 2}), "labels",
-                                            Interpolation::Nearest);
+  in.volumes["scalars"] = MakeTyped<float>(
+      {8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}), "scalars");
+  in.volumes["labels"] =
+      MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({0.5, 0.5, 0.5}, {2, 2, 2}), "labels", Interpolation::Nearest);
   testing::internal::CaptureStderr();
   Scene scene = SceneFromJson(doc, in);
   const std::string warning = testing::internal::GetCapturedStderr();
@@ -156,8 +161,8 @@ TEST(LabelAlignment, SceneResamplesReadLabelMaps) {
 
   // A label map on the grid already: no copy, no warning. A continuous proxy
   // on another grid is left as it is.
-  in.volumes["labels"] = MakeTyped<uint8_t>({8, 8, 8}, LabelOf, Grid({0, 0, 0}, {1, 1, 1}), "labels",
-                                            Interpolation::Nearest);
+  in.volumes["labels"] =
+      MakeTyped<uint8_t>({8, 8, 8}, LabelOf, Grid({0, 0, 0}, {1, 1, 1}), "labels", Interpolation::Nearest);
   testing::internal::CaptureStderr();
   scene = SceneFromJson(doc, in);
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
@@ -173,10 +178,10 @@ TEST(LabelAlignment, SceneLeavesUnreadLabelMapsAlone) {
   // An unread label map is dropped before alignment: even one far away is no error.
   const nlohmann::json doc = nlohmann::json::parse(R"({"materials": {"m": {}}})");
   SceneInputs in;
-  in.volumes["scalars"] =
-      MakeTyped<float>({8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}), "scalars");
-  in.volumes["labels"] = MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({500, 0, 0}, {2, 2, 2}), "labels",
-                                            Interpolation::Nearest);
+  in.volumes["scalars"] = MakeTyped<float>(
+      {8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}), "scalars");
+  in.volumes["labels"] =
+      MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({500, 0, 0}, {2, 2, 2}), "labels", Interpolation::Nearest);
   testing::internal::CaptureStderr();
   Scene scene = SceneFromJson(doc, in);
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
@@ -188,10 +193,10 @@ TEST(LabelAlignment, SceneErrorNamesBothFiles) {
     "materials": {"m": {"tfs": {"density": [{"type": "cdptf", "proxy": "labels", "points": [[1, 1]]}]}}}
   })");
   SceneInputs in;
-  in.volumes["scalars"] =
-      MakeTyped<float>({8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}), "scalars");
-  in.volumes["labels"] = MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({500, 0, 0}, {2, 2, 2}), "labels",
-                                            Interpolation::Nearest);
+  in.volumes["scalars"] = MakeTyped<float>(
+      {8, 8, 8}, [](int, int, int) { return 0; }, Grid({0, 0, 0}, {1, 1, 1}), "scalars");
+  in.volumes["labels"] =
+      MakeTyped<uint8_t>({4, 4, 4}, LabelOf, Grid({500, 0, 0}, {2, 2, 2}), "labels", Interpolation::Nearest);
   try {
     SceneFromJson(doc, in);
     FAIL() << "no error";

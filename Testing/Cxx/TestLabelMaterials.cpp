@@ -149,8 +149,9 @@ TEST(LabelMaterials, ALabelsLookIsOneMaterial) {
   EXPECT_EQ(LabelMaterial(look)["density"], 0.0);
   // Through the scene format: the label's material is this one.
   look.visible = true;
-  const json doc = {{"label_materials",
-                     {{"classes", json::array({{{"ids", {7}}, {"color", "material"}, {"material", LabelMaterial(look)}}})}}}};
+  const json doc = {
+      {"label_materials",
+       {{"classes", json::array({{{"ids", {7}}, {"color", "material"}, {"material", LabelMaterial(look)}}})}}}};
   const json expanded = ExpandLabelMaterials(doc, {7}, nullptr);
   EXPECT_DOUBLE_EQ(expanded["materials"]["label_7"]["density"].get<double>(), 0.4 * kLabelDensityAtFullOpacity);
   EXPECT_EQ(expanded["materials"]["label_7"]["albedo"], json::array({0.8, 0.2, 0.1}));

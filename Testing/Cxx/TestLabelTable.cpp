@@ -35,7 +35,9 @@ std::string ErrorOf(const std::string& name, const std::string& text) {
   return "";
 }
 
-float Distance(RGB a, RGB b) { return std::sqrt((a.r - b.r) * (a.r - b.r) + (a.g - b.g) * (a.g - b.g) + (a.b - b.b) * (a.b - b.b)); }
+float Distance(RGB a, RGB b) {
+  return std::sqrt((a.r - b.r) * (a.r - b.r) + (a.g - b.g) * (a.g - b.g) + (a.b - b.b) * (a.b - b.b));
+}
 
 }  // namespace
 

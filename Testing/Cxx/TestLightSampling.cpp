@@ -19,9 +19,9 @@ namespace {
 // medium that casts shadows: each light's share differs from pixel to pixel.
 // `density` 1 casts shadows; a thin medium hardly any.
 Scene MakeScene(LightSampling mode, float sunScale = 1.f, float density = 1.f) {
-  Scene scene = test::MakeMediumScene(
-      test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }), density,
-      RGB(0.9f, 0.7f, 0.5f), 0.3f);
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }),
+                            density, RGB(0.9f, 0.7f, 0.5f), 0.3f);
   scene.materials[0].base[6] = 0.5f;
   scene.environment = EnvironmentMap::DefaultSky();
   Light sun;

@@ -211,8 +211,8 @@ TEST_P(Conservative, MinorantsUnderALabelMapAndACurve) {
   // where the label and the ramp's upper values fill a leaf.
   HostVolume ct = LoadVolume(Data("cta_chest_aorta.nii.gz"));
   HostVolume labels = LoadVolume(Data("cta_chest_aorta_labels.nii.gz"), "labels", Interpolation::Nearest);
-  Scene scene = SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({-1000.f, 100.f}, {0.5f, 1.f})}, 5.f,
-                          GetParam());
+  Scene scene =
+      SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({-1000.f, 100.f}, {0.5f, 1.f})}, 5.f, GetParam());
   SceneView s = scene.Build();
   Violations v = CheckAlongRandomRays(s, 1500, 1.f, 17);
   EXPECT_EQ(v.underMinorant, 0) << "of " << v.lookups << " lookups";
@@ -272,8 +272,8 @@ TEST(LabelSummaries, ALabelMapOnTheImageGridIsSummarizedOverExactVoxelBoxes) {
   HostVolume ct = LoadVolume(Data("cta_chest_aorta.nii.gz"));
   HostVolume labels = LoadVolume(Data("cta_chest_aorta_labels.nii.gz"), "labels", Interpolation::Nearest);
   ASSERT_TRUE(OnSameVoxelGrid(labels, ct));
-  Scene scene =
-      SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({-5000.f, 5000.f}, {1.f, 1.f})}, 1.f, MajorantKind::Octree);
+  Scene scene = SceneWith({ct, labels}, {SingleLabel(3.f, 1.f, 1), CCTF({-5000.f, 5000.f}, {1.f, 1.f})}, 1.f,
+                          MajorantKind::Octree);
   const SceneView s = scene.Build();
   EXPECT_TRUE(s.classifier.onProxy0Grid[1]);
   const MajorantGridView& g = scene.Grid()->View();
@@ -306,8 +306,7 @@ TEST(LabelSummaries, ALabelMapOnTheImageGridIsSummarizedOverExactVoxelBoxes) {
   EXPECT_EQ(nonEmpty, (int64_t)expected.size());
 }
 
-INSTANTIATE_TEST_SUITE_P(Accelerators, Conservative,
-                         ::testing::Values(MajorantKind::Macrocell, MajorantKind::Octree),
+INSTANTIATE_TEST_SUITE_P(Accelerators, Conservative, ::testing::Values(MajorantKind::Macrocell, MajorantKind::Octree),
                          [](const auto& info) { return info.param == MajorantKind::Octree ? "Octree" : "Macrocell"; });
 
 TEST(VoxelMaxRefit, ViolatesConservativenessUnderANarrowPeak) {
@@ -377,7 +376,8 @@ TEST(Refit, OnlyWhenWhatARefitReadsChanged) {
       {"a TF value", [](Scene& s) { s.tfs[0].values[1] = 0.5f; }},
       {"a TF key", [](Scene& s) { s.tfs[0].keys[0] = 1000.f; }},
       {"the density", [](Scene& s) { s.materials[0].base[0] = 1e4f; }},  // now clamped by MaxExtinction()
-      {"the voxel spacing", [](Scene& s) {
+      {"the voxel spacing",
+       [](Scene& s) {
          for (auto& row : s.proxies[0].indexToWorld.m)
            for (int a = 0; a < 3; ++a) row[a] *= 2.f;
        }},

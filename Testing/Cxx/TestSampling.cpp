@@ -157,8 +157,7 @@ TEST(EnvironmentLight, SamplingMatchesPdf) {
           if (s.pdf > 0) {
             ++samples;
             const RGB Le = view.Le(s.wi);
-            if (!(std::abs(s.pdf - view.Pdf(s.wi)) <= 1e-3f * s.pdf) || Le.r != s.L.r || Le.g != s.L.g ||
-                Le.b != s.L.b)
+            if (!(std::abs(s.pdf - view.Pdf(s.wi)) <= 1e-3f * s.pdf) || Le.r != s.L.r || Le.g != s.L.g || Le.b != s.L.b)
               ++mismatches;
           }
           return s.pdf > 0.f;

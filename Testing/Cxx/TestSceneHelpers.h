@@ -11,8 +11,8 @@
 namespace mmrtm::test {
 
 // A float volume of dims n^3 ... with value f(i, j, k), unit spacing at the origin.
-inline HostVolume MakeVolume(int nx, int ny, int nz, const std::function<float(int, int, int)>& f,
-                             float spacing = 1.f, const char* name = "scalars") {
+inline HostVolume MakeVolume(int nx, int ny, int nz, const std::function<float(int, int, int)>& f, float spacing = 1.f,
+                             const char* name = "scalars") {
   HostVolume v;
   v.name = name;
   v.source = name;
@@ -28,7 +28,8 @@ inline HostVolume MakeVolume(int nx, int ny, int nz, const std::function<float(i
 }
 
 inline HostVolume MakeConstantVolume(int n, float value, float spacing = 1.f) {
-  return MakeVolume(n, n, n, [value](int, int, int) { return value; }, spacing);
+  return MakeVolume(
+      n, n, n, [value](int, int, int) { return value; }, spacing);
 }
 
 // A CCTF over proxy 0 mapping value v to v (identity), for density.

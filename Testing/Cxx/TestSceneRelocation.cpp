@@ -20,14 +20,13 @@ Scene RichScene() {
   // Labels (MDPTF), a range material TF (MPCTF), CCTFs, the default sky's
   // importance-sampling tables, a directional and a point light, the octree.
   nlohmann::json doc = ReadJsonFile(std::string(MMRTM_DATA_DIR) + "/presets/ct-angio-labels.json");
-  doc["material_tfs"].push_back(
-      {{"type", "mpctf"}, {"proxy", "scalars"}, {"ranges", {{1200, 4000, "vertebra"}}}});
+  doc["material_tfs"].push_back({{"type", "mpctf"}, {"proxy", "scalars"}, {"ranges", {{1200, 4000, "vertebra"}}}});
   doc["lights"].push_back({{"type", "point"}, {"position", {0, -300, 0}}, {"intensity", 2e4}});
   doc["render"] = {{"width", 40}, {"height", 32}, {"spp", 4}, {"seed", 5u}};
   SceneInputs inputs;
   inputs.volumes["scalars"] = LoadVolume(std::string(MMRTM_SHARED_DATA_DIR) + "/cta_chest_aorta.nii.gz");
-  inputs.volumes["labels"] =
-      LoadVolume(std::string(MMRTM_SHARED_DATA_DIR) + "/cta_chest_aorta_labels.nii.gz", "labels", Interpolation::Nearest);
+  inputs.volumes["labels"] = LoadVolume(std::string(MMRTM_SHARED_DATA_DIR) + "/cta_chest_aorta_labels.nii.gz", "labels",
+                                        Interpolation::Nearest);
   return SceneFromJson(doc, std::move(inputs));
 }
 

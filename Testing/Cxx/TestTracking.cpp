@@ -69,8 +69,8 @@ TEST(Tracking, LinearRampFollowsBeerLambert) {
   // sigma_t grows linearly along x from 0 to 0.4 over 20 mm, trilinearly
   // interpolated between voxel centres: optical depth 0.5 * 0.4 * 20 = 4.
   const int n = 21;
-  Scene scene = test::MakeMediumScene(
-      test::MakeVolume(n, 5, 5, [](int i, int, int) { return i / 20.f; }), 0.4f, RGB(1.f));
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(n, 5, 5, [](int i, int, int) { return i / 20.f; }), 0.4f, RGB(1.f));
   SceneView s = scene.Build();
   const Ray ray{{-1.f, 2.f, 2.f}, {1.f, 0.f, 0.f}};
   const double expected = std::exp(-4.0);
@@ -102,8 +102,8 @@ TEST(Tracking, ResidualRatioTrackingHasLessVarianceThanRatioTracking) {
   // same view without minorants) and residual ratio tracking both agree
   // with Beer-Lambert; the residual one with less variance and fewer lookups.
   const int n = 21;
-  Scene scene = test::MakeMediumScene(
-      test::MakeVolume(n, 5, 5, [](int i, int, int) { return i / 20.f; }), 0.4f, RGB(1.f));
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(n, 5, 5, [](int i, int, int) { return i / 20.f; }), 0.4f, RGB(1.f));
   SceneView residual = scene.Build();
   ASSERT_NE(residual.majorants.grid.minorants, nullptr);
   SceneView plain = residual;

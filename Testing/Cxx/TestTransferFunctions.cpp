@@ -153,8 +153,8 @@ TEST(TransferFunction, CDPTFWideKeysUseBinarySearch) {
 
 TEST(TransferFunction, MaterialTFsPickMaterials) {
   Scene s = SceneWithMaterialsAB();
-  SceneView v = BuildWith(s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}),
-                              MaterialTF(TFType::MDPTF, 0, {2, 7}, {0, 1})});
+  SceneView v =
+      BuildWith(s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}), MaterialTF(TFType::MDPTF, 0, {2, 7}, {0, 1})});
   const TransferFunctionView& mp = v.classifier.tfs[0];
   const TransferFunctionView& md = v.classifier.tfs[1];
   EXPECT_EQ(mp.EvaluateMaterial(-1.f), kNoMaterial);
@@ -227,10 +227,9 @@ TEST(TransferFunction, MinOverRangeBoundsEveryValueFromBelow) {
 
 TEST(TransferFunction, CoversRangeSaysWhetherEveryValueHasAnEntry) {
   Scene s = SceneWithMaterialsAB();
-  SceneView v = BuildWith(s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}),
-                              MaterialTF(TFType::MPCTF, 0, {4, 10, 0, 6}, {0, 1}),
-                              MaterialTF(TFType::MDPTF, 0, {2, 3, 4, 7}, {0, 1, 0, 1}),
-                              Coefficient(TFType::CCTF, 0, 1, {0, 1}, {0, 1})});
+  SceneView v = BuildWith(
+      s, {MaterialTF(TFType::MPCTF, 0, {0, 5, 5, 8}, {1, 0}), MaterialTF(TFType::MPCTF, 0, {4, 10, 0, 6}, {0, 1}),
+          MaterialTF(TFType::MDPTF, 0, {2, 3, 4, 7}, {0, 1, 0, 1}), Coefficient(TFType::CCTF, 0, 1, {0, 1}, {0, 1})});
   const TransferFunctionView &adjacent = v.classifier.tfs[0], &overlapping = v.classifier.tfs[1],
                              &labels = v.classifier.tfs[2], &curve = v.classifier.tfs[3];
   EXPECT_TRUE(adjacent.CoversRange(0.f, 7.9f));

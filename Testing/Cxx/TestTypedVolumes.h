@@ -20,8 +20,9 @@ constexpr VoxelType TypeOf() {
 
 // A volume of voxel type T with value f(i, j, k) and the given geometry.
 template <typename T>
-HostVolume MakeTyped(std::array<int, 3> dims, const std::function<double(int, int, int)>& f, const Affine3& indexToWorld,
-                     const std::string& name = "scalars", Interpolation interpolation = Interpolation::Trilinear) {
+HostVolume MakeTyped(std::array<int, 3> dims, const std::function<double(int, int, int)>& f,
+                     const Affine3& indexToWorld, const std::string& name = "scalars",
+                     Interpolation interpolation = Interpolation::Trilinear) {
   HostVolume v;
   v.name = name;
   v.source = name + ".nrrd";

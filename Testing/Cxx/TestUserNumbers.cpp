@@ -70,8 +70,8 @@ TEST(UserNumbers, HugeDensityOverAVaryingTransferFunctionFinishes) {
   // A ramp of values under a density of 1e30: the majorant of a cell is the
   // cap while most of its points are far below it, the case where null
   // collisions would explode without the clamp.
-  Scene scene = test::MakeMediumScene(test::MakeVolume(16, 16, 16, [](int i, int, int) { return i / 15.f; }), 1e30f,
-                                      RGB(0.8f));
+  Scene scene =
+      test::MakeMediumScene(test::MakeVolume(16, 16, 16, [](int i, int, int) { return i / 15.f; }), 1e30f, RGB(0.8f));
   const SceneView view = scene.Build();
   EXPECT_FALSE(scene.ExtinctionWarning().empty());
   Film film(16, 16);
@@ -94,8 +94,9 @@ TEST(UserNumbers, ZeroDensityIsAnEmptyVolume) {
 
 TEST(UserNumbers, FineVoxelsRaiseTheCap) {
   // The cap is an optical depth per voxel: 0.1 mm voxels allow 10x the extinction.
-  Scene scene =
-      test::MakeMediumScene(test::MakeVolume(8, 8, 8, [](int, int, int) { return 1.f; }, 0.1f), 100.f, RGB(0.5f));
+  Scene scene = test::MakeMediumScene(test::MakeVolume(
+                                          8, 8, 8, [](int, int, int) { return 1.f; }, 0.1f),
+                                      100.f, RGB(0.5f));
   scene.Build();
   EXPECT_FLOAT_EQ(scene.MaxExtinction(), kMaxOpticalDepthPerVoxel / 0.1f);
   EXPECT_TRUE(scene.ExtinctionWarning().empty()) << scene.ExtinctionWarning();

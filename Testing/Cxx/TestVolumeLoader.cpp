@@ -438,7 +438,8 @@ std::string CopyFrogWithHeaderEdit(const std::string& folder, const std::string&
 // stream, and ITK read garbage into the last slices. Here the whole stream is
 // read and checked, with a warning about the header.
 TEST(VolumeLoader, MetaImageWithWrongCompressedSizeWarnsAndReadsEverything) {
-  const std::string header = CopyFrogWithHeaderEdit("frog", "CompressedDataSize = 262087", "CompressedDataSize = 260020");
+  const std::string header =
+      CopyFrogWithHeaderEdit("frog", "CompressedDataSize = 262087", "CompressedDataSize = 260020");
   std::vector<std::string> warnings;
   mmrtm::VolumeLoadOptions options;
   options.warn = [&](const std::string& w) { warnings.push_back(w); };

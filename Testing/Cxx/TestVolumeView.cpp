@@ -23,8 +23,9 @@ double Pattern(int i, int j, int k) { return std::fmod(37.0 * i + 101.0 * j * j 
 template <typename T>
 HostVolume Make(std::array<int, 3> dims) {
   const bool isSigned = std::is_same_v<T, int16_t> || std::is_same_v<T, float>;
-  return MakeTyped<T>(dims, [&](int i, int j, int k) { return isSigned ? Pattern(i, j, k) - 120.0 : Pattern(i, j, k); },
-                      Grid({0, 0, 0}, {1, 1, 1}));
+  return MakeTyped<T>(
+      dims, [&](int i, int j, int k) { return isSigned ? Pattern(i, j, k) - 120.0 : Pattern(i, j, k); },
+      Grid({0, 0, 0}, {1, 1, 1}));
 }
 
 bool SameBits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
@@ -123,10 +124,12 @@ TEST(VolumeView, TrilinearMatchesItsDefinition) {
 TEST(VolumeView, FlatAxesInterpolateTheOtherTwo) {
   // A single slice (and a single row): the flat axis has one voxel, which
   // both corners of a cell are; nothing is read beyond the volume.
-  for (std::array<int, 3> dims : {std::array<int, 3>{6, 5, 1}, std::array<int, 3>{6, 1, 1}, std::array<int, 3>{1, 1, 1}}) {
+  for (std::array<int, 3> dims :
+       {std::array<int, 3>{6, 5, 1}, std::array<int, 3>{6, 1, 1}, std::array<int, 3>{1, 1, 1}}) {
     const HostVolume host = Make<float>(dims);
     const VolumeView v = host.View();
-    for (Vec3 p : Points(dims, 500)) ASSERT_NEAR(v.SampleIndex(p), Reference(host, p), 1e-3) << dims[0] << dims[1] << dims[2];
+    for (Vec3 p : Points(dims, 500))
+      ASSERT_NEAR(v.SampleIndex(p), Reference(host, p), 1e-3) << dims[0] << dims[1] << dims[2];
     EXPECT_FALSE(v.NeighbourCellsAreExact({2.5f, 0.f, 0.f}));
   }
 }
@@ -154,5 +157,6 @@ TEST(VolumeView, CentralDifferencesOfALabelMapUseSixNearestLookups) {
   HostVolume host = Make<uint8_t>({12, 10, 8});
   host.interpolation = Interpolation::Nearest;
   const VolumeView v = host.View();
-  for (Vec3 p : Points({12, 10, 8}, 500)) ASSERT_TRUE(SameBits(v.CentralDifferences(p), v.CentralDifferencesBySixLookups(p)));
+  for (Vec3 p : Points({12, 10, 8}, 500))
+    ASSERT_TRUE(SameBits(v.CentralDifferences(p), v.CentralDifferencesBySixLookups(p)));
 }

@@ -93,11 +93,13 @@ struct ErrorCounter
   ErrorCounter()
   {
     command->SetClientData(this);
-    command->SetCallback([](vtkObject*, unsigned long, void* self, void* message) {
-      auto* counter = static_cast<ErrorCounter*>(self);
-      ++counter->errors;
-      counter->last = message ? static_cast<const char*>(message) : "";
-    });
+    command->SetCallback(
+      [](vtkObject*, unsigned long, void* self, void* message)
+      {
+        auto* counter = static_cast<ErrorCounter*>(self);
+        ++counter->errors;
+        counter->last = message ? static_cast<const char*>(message) : "";
+      });
   }
   void Observe(vtkObject* object) { object->AddObserver(vtkCommand::ErrorEvent, command); }
 };
@@ -247,8 +249,7 @@ void Soak(const Options& options, std::vector<std::pair<int, double>>& curve)
   auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(random); };
   auto pick = [&](int n) { return std::uniform_int_distribution<int>(0, n - 1)(random); };
 
-  const vtkSmartPointer<vtkImageData> inputs[3] = { Ball(40, false, 1.0), Ball(28, true, 1.5),
-                                                    Ball(48, false, 0.8) };
+  const vtkSmartPointer<vtkImageData> inputs[3] = { Ball(40, false, 1.0), Ball(28, true, 1.5), Ball(48, false, 0.8) };
   vtkSmartPointer<vtkImageData> labels[3];
   for (int i = 0; i < 3; ++i)
     labels[i] = Shells(inputs[i]);
@@ -352,8 +353,7 @@ void Soak(const Options& options, std::vector<std::pair<int, double>>& curve)
     if (covered == 0)
       ++emptyImages;
   }
-  const double seconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "soak: " << options.iterations << " iterations in " << seconds << " s ("
             << 1000.0 * seconds / std::max(options.iterations, 1) << " ms each); actions";
   for (int a = 0; a < 6; ++a)
@@ -456,13 +456,13 @@ void ReleaseThenRender(bool wholeWindow)
     differing += before[i] != after[i];
   Check(firstCovered > 0.1, what + " then Render: the first frame shows the volume");
   Check(covered > 0.1 && differing == 0,
-        what + " then Render: the same film (" + std::to_string(differing) + " values differ)");
-  Check(litBefore > 100 && litAfter == litBefore, what + " then Render: the same pixels lit (" +
-                                                      std::to_string(litBefore) + ", then " +
-                                                      std::to_string(litAfter) + ")");
+    what + " then Render: the same film (" + std::to_string(differing) + " values differ)");
+  Check(litBefore > 100 && litAfter == litBefore,
+    what + " then Render: the same pixels lit (" + std::to_string(litBefore) + ", then " + std::to_string(litAfter) +
+      ")");
   Check(view.errors.errors == 0, what + " then Render: no error");
-  std::cout << what << " then render: " << differing << " film values differ, " << litAfter << " of "
-            << litBefore << " pixels lit" << std::endl;
+  std::cout << what << " then render: " << differing << " film values differ, " << litAfter << " of " << litBefore
+            << " pixels lit" << std::endl;
 }
 
 // The input removed while a pass refines on its thread: an error on the
@@ -481,8 +481,8 @@ void InputRemovedWhileRefining()
   view.mapper->RemoveAllInputConnections(0);
   view.window->Render();
   Check(view.errors.errors > 0, "input removed: an error names the missing input");
-  std::cout << "input removed while refining (a pass was " << (wasRefining ? "" : "not ")
-            << "in flight): error \"" << view.errors.last.substr(0, 120) << "\"" << std::endl;
+  std::cout << "input removed while refining (a pass was " << (wasRefining ? "" : "not ") << "in flight): error \""
+            << view.errors.last.substr(0, 120) << "\"" << std::endl;
   const int errorsBefore = view.errors.errors;
   view.mapper->SetInputData(input);
   view.mapper->AsynchronousRefinementOff();
@@ -507,8 +507,8 @@ void WindowClosedWhileRefining()
   const bool wasRefining = view->mapper->IsRefining();
   view->window->Finalize(); // the user closes the window
   view.reset();             // and the application lets go of it all
-  std::cout << "window closed while refining (a pass was " << (wasRefining ? "" : "not ")
-            << "in flight): no crash" << std::endl;
+  std::cout << "window closed while refining (a pass was " << (wasRefining ? "" : "not ") << "in flight): no crash"
+            << std::endl;
 }
 } // namespace
 
@@ -552,11 +552,10 @@ int main(int argc, char* argv[])
   if (curve.size() >= 3)
   {
     const double warm = curve[std::max<size_t>(1, curve.size() / 10)].second, last = curve.back().second;
-    const double peak = std::max_element(curve.begin(), curve.end(), [](auto& x, auto& y) {
-                          return x.second < y.second;
-                        })->second;
-    std::printf("resident memory: %.1f MB at iteration %d, %.1f MB at the end (%+.1f MB), peak %.1f MB\n",
-                warm, curve[std::max<size_t>(1, curve.size() / 10)].first, last, last - warm, peak);
+    const double peak =
+      std::max_element(curve.begin(), curve.end(), [](auto& x, auto& y) { return x.second < y.second; })->second;
+    std::printf("resident memory: %.1f MB at iteration %d, %.1f MB at the end (%+.1f MB), peak %.1f MB\n", warm,
+      curve[std::max<size_t>(1, curve.size() / 10)].first, last, last - warm, peak);
   }
   if (!options.csv.empty())
   {

@@ -55,8 +55,8 @@
 
 namespace
 {
-constexpr int kSize = 64;    // the window: small, the test is about state, not pixels
-constexpr int kSamples = 4;  // per pixel, one render
+constexpr int kSize = 64;   // the window: small, the test is about state, not pixels
+constexpr int kSamples = 4; // per pixel, one render
 constexpr int kSeed = 7;
 
 // The objects a case sets up and edits. Each mapper gets its own property
@@ -67,25 +67,25 @@ struct Objects
   vtkMultiMaterialVolumeMapper* mapper;
   vtkPiecewiseFunction* opacity;
   vtkColorTransferFunction* color;
-  vtkTexture* environment;  // the environment texture of the case's mapper
-  vtkPlane* plane;          // a clipping plane of the case's mapper
+  vtkTexture* environment; // the environment texture of the case's mapper
+  vtkPlane* plane;         // a clipping plane of the case's mapper
 };
 
 enum class Input
 {
-  Head,          // ct_head_headsq.nrrd, every other voxel: 32 x 32 x 47 int16
-  HeadLabels,    // the same with a label map (labels 1 and 2) as the mask
-  TwoComponents  // 32^3, 2 unsigned char components
+  Head,         // ct_head_headsq.nrrd, every other voxel: 32 x 32 x 47 int16
+  HeadLabels,   // the same with a label map (labels 1 and 2) as the mask
+  TwoComponents // 32^3, 2 unsigned char components
 };
 
 // The work an edit must cause in the mapper, and no more.
 enum class Work
 {
-  Display,      // none: the accumulation goes on (the exposure, no change at all)
-  Restart,      // the accumulation restarts; nothing translated, no refit
-  Refit,        // the property translated again (the majorants refitted if they read what changed)
-  Rebuild,      // the proxies and the grid's summaries built again
-  Accelerator,  // a restart; the grid built or refitted for the new accelerator
+  Display,     // none: the accumulation goes on (the exposure, no change at all)
+  Restart,     // the accumulation restarts; nothing translated, no refit
+  Refit,       // the property translated again (the majorants refitted if they read what changed)
+  Rebuild,     // the proxies and the grid's summaries built again
+  Accelerator, // a restart; the grid built or refitted for the new accelerator
 };
 
 struct Case
@@ -93,7 +93,7 @@ struct Case
   std::string name;
   Input input;
   std::function<void(Objects&)> setup, edit;
-  bool changesImage = true;  // false: documented as not used by the film
+  bool changesImage = true; // false: documented as not used by the film
   Work work = Work::Refit;
 };
 
@@ -290,24 +290,29 @@ std::vector<Case> Cases()
 {
   std::vector<Case> c;
   // vtkVolumeProperty: its functions, edited in place.
-  c.push_back({ "scalar-opacity-point", Input::Head, HeadFunctions,
-    [](Objects& o) { o.opacity->AddPoint(1100, 0.8); } });
-  c.push_back({ "scalar-opacity-replaced", Input::Head, HeadFunctions, [](Objects& o) {
-                 vtkNew<vtkPiecewiseFunction> f;
-                 o.property->SetScalarOpacity(Ramp(f, 1000, 3000));
-               } });
-  c.push_back({ "unit-distance", Input::Head, HeadFunctions,
-    [](Objects& o) { o.property->SetScalarOpacityUnitDistance(3.0); } });
-  c.push_back({ "color-rgb-point", Input::Head, HeadFunctions,
-    [](Objects& o) { o.color->AddRGBPoint(1300, 0.2, 0.5, 0.9); } });
-  c.push_back({ "color-rgb-to-gray", Input::Head, HeadFunctions, [](Objects& o) {
-                 vtkNew<vtkPiecewiseFunction> gray;
-                 gray->AddPoint(500, 0.3);
-                 gray->AddPoint(2500, 0.9);
-                 o.property->SetColor(gray);
-               } });
+  c.push_back(
+    { "scalar-opacity-point", Input::Head, HeadFunctions, [](Objects& o) { o.opacity->AddPoint(1100, 0.8); } });
+  c.push_back({ "scalar-opacity-replaced", Input::Head, HeadFunctions,
+    [](Objects& o)
+    {
+      vtkNew<vtkPiecewiseFunction> f;
+      o.property->SetScalarOpacity(Ramp(f, 1000, 3000));
+    } });
+  c.push_back(
+    { "unit-distance", Input::Head, HeadFunctions, [](Objects& o) { o.property->SetScalarOpacityUnitDistance(3.0); } });
+  c.push_back(
+    { "color-rgb-point", Input::Head, HeadFunctions, [](Objects& o) { o.color->AddRGBPoint(1300, 0.2, 0.5, 0.9); } });
+  c.push_back({ "color-rgb-to-gray", Input::Head, HeadFunctions,
+    [](Objects& o)
+    {
+      vtkNew<vtkPiecewiseFunction> gray;
+      gray->AddPoint(500, 0.3);
+      gray->AddPoint(2500, 0.9);
+      o.property->SetColor(gray);
+    } });
   c.push_back({ "color-gray-point", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       HeadFunctions(o);
       vtkNew<vtkPiecewiseFunction> gray;
       gray->AddPoint(500, 0.3);
@@ -318,14 +323,16 @@ std::vector<Case> Cases()
   c.push_back({ "gradient-opacity-enabled", Input::Head, HeadFunctions,
     [](Objects& o) { Ramp(o.property->GetGradientOpacity(), 0, 300); } });
   c.push_back({ "gradient-opacity-point", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       HeadFunctions(o);
       vtkNew<vtkPiecewiseFunction> g;
       o.property->SetGradientOpacity(Ramp(g, 0, 300));
     },
     [](Objects& o) { o.property->GetGradientOpacity()->AddPoint(100, 0.9); } });
   c.push_back({ "gradient-opacity-disabled", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       HeadFunctions(o);
       vtkNew<vtkPiecewiseFunction> g;
       o.property->SetGradientOpacity(Ramp(g, 0, 300));
@@ -338,15 +345,17 @@ std::vector<Case> Cases()
   c.push_back({ "specular", Input::Head, Shaded, [](Objects& o) { o.property->SetSpecular(0.0); } });
   c.push_back({ "specular-power", Input::Head, Shaded, [](Objects& o) { o.property->SetSpecularPower(60); } });
   c.push_back({ "interpolation-nearest", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       HeadFunctions(o);
-      o.property->SetInterpolationTypeToLinear();  // VTK's default is nearest
+      o.property->SetInterpolationTypeToLinear(); // VTK's default is nearest
     },
     [](Objects& o) { o.property->SetInterpolationTypeToNearest(); }, false });
   c.push_back({ "transfer-function-2d", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       HeadFunctions(o);
-      vtkNew<vtkImageData> table;  // x: scalar value, y: gradient magnitude
+      vtkNew<vtkImageData> table; // x: scalar value, y: gradient magnitude
       table->SetDimensions(16, 8, 1);
       table->SetOrigin(0, 0, 0);
       table->SetSpacing(4000.0 / 15, 600.0 / 7, 1);
@@ -363,7 +372,8 @@ std::vector<Case> Cases()
       o.property->SetTransferFunction2D(table);
       o.property->SetTransferFunctionMode(vtkVolumeProperty::TF_2D);
     },
-    [](Objects& o) {
+    [](Objects& o)
+    {
       vtkImageData* table = o.property->GetTransferFunction2D();
       auto* p = static_cast<float*>(table->GetScalarPointer());
       for (int i = 0; i < 16 * 8; ++i)
@@ -375,7 +385,8 @@ std::vector<Case> Cases()
   c.push_back({ "independent-components-off", Input::TwoComponents, TwoComponentFunctions,
     [](Objects& o) { o.property->IndependentComponentsOff(); } });
   c.push_back({ "independent-components-on", Input::TwoComponents,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       TwoComponentFunctions(o);
       o.property->IndependentComponentsOff();
     },
@@ -395,40 +406,47 @@ std::vector<Case> Cases()
     [](Objects& o) { o.property->GetLabelScalarOpacity(1)->AddPoint(1000, 0.05); } });
   c.push_back({ "label-color-point", Input::HeadLabels, labelled,
     [](Objects& o) { o.property->GetLabelColor(2)->AddRGBPoint(1000, 0.1, 0.9, 0.1); } });
-  c.push_back({ "label-color-replaced", Input::HeadLabels, labelled, [](Objects& o) {
-                 vtkNew<vtkColorTransferFunction> green;
-                 green->AddRGBPoint(0, 0.1, 0.8, 0.2);
-                 o.property->SetLabelColor(1, green);
-               } });
-  c.push_back({ "label-gradient-opacity", Input::HeadLabels, labelled, [](Objects& o) {
-                 vtkNew<vtkPiecewiseFunction> g;
-                 o.property->SetLabelGradientOpacity(2, Ramp(g, 0, 200));
-               } });
-  c.push_back({ "label-added", Input::HeadLabels,
-    [](Objects& o) { Labelled(o, false); },
-    [](Objects& o) {
+  c.push_back({ "label-color-replaced", Input::HeadLabels, labelled,
+    [](Objects& o)
+    {
+      vtkNew<vtkColorTransferFunction> green;
+      green->AddRGBPoint(0, 0.1, 0.8, 0.2);
+      o.property->SetLabelColor(1, green);
+    } });
+  c.push_back({ "label-gradient-opacity", Input::HeadLabels, labelled,
+    [](Objects& o)
+    {
+      vtkNew<vtkPiecewiseFunction> g;
+      o.property->SetLabelGradientOpacity(2, Ramp(g, 0, 200));
+    } });
+  c.push_back({ "label-added", Input::HeadLabels, [](Objects& o) { Labelled(o, false); },
+    [](Objects& o)
+    {
       vtkNew<vtkColorTransferFunction> yellow;
       yellow->AddRGBPoint(0, 0.9, 0.9, 0.1);
       o.property->SetLabelColor(2, yellow);
     } });
-  c.push_back({ "label-material", Input::HeadLabels, labelled, [](Objects& o) {
-                 o.mapper->SetLabelMaterialParameters(1, R"({"roughness": 0.2, "metallic": 1, "surface_probability": 1})");
-               } });
+  c.push_back({ "label-material", Input::HeadLabels, labelled,
+    [](Objects& o)
+    { o.mapper->SetLabelMaterialParameters(1, R"({"roughness": 0.2, "metallic": 1, "surface_probability": 1})"); } });
   c.push_back({ "label-material-edited", Input::HeadLabels,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       Labelled(o);
       o.mapper->SetLabelMaterialParameters(1, R"({"roughness": 0.2, "surface_probability": 1})");
     },
     [](Objects& o) { o.mapper->SetLabelMaterialParameters(1, R"({"emission": [2, 0, 0]})"); } });
   c.push_back({ "label-material-removed", Input::HeadLabels,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       Labelled(o);
       o.mapper->SetLabelMaterialParameters(2, R"({"anisotropy": 0.8, "emission": [0, 0, 3]})");
     },
     [](Objects& o) { o.mapper->RemoveAllLabelMaterialParameters(); } });
   c.push_back({ "mask-binary", Input::HeadLabels, labelled, [](Objects& o) { o.mapper->SetMaskTypeToBinary(); } });
   // Labels by the one label rule (SetLabelMaterial: how Slicer's segments come).
-  const auto looks = [](Objects& o) {
+  const auto looks = [](Objects& o)
+  {
     Labelled(o, false);
     o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.6);
   };
@@ -440,66 +458,70 @@ std::vector<Case> Cases()
     [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.2); } });
   c.push_back({ "label-look-over-functions", Input::HeadLabels, labelled,
     [](Objects& o) { o.mapper->SetLabelMaterial(2, 0.9, 0.9, 0.1, 1.0); } });
-  c.push_back({ "label-look-removed", Input::HeadLabels, looks,
-    [](Objects& o) { o.mapper->RemoveLabelMaterial(1); } });
+  c.push_back({ "label-look-removed", Input::HeadLabels, looks, [](Objects& o) { o.mapper->RemoveLabelMaterial(1); } });
   c.push_back({ "label-look-same-values", Input::HeadLabels, looks,
     [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.6); }, false, Work::Display });
 
   // The mapper's own settings.
   c.push_back({ "seed", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetSeed(kSeed + 1); } });
   c.push_back({ "maximum-bounces", Input::Head, Shaded, [](Objects& o) { o.mapper->SetMaximumBounces(1); } });
-  c.push_back({ "shadow-extinction-scale", Input::Head, Shaded,
-    [](Objects& o) { o.mapper->SetShadowExtinctionScale(1.0); } });
+  c.push_back(
+    { "shadow-extinction-scale", Input::Head, Shaded, [](Objects& o) { o.mapper->SetShadowExtinctionScale(1.0); } });
   c.push_back({ "sampler", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetSamplerToIndependent(); } });
-  c.push_back({ "accelerator", Input::Head, HeadFunctions,
-    [](Objects& o) { o.mapper->SetAcceleratorToMacrocell(); } });
+  c.push_back({ "accelerator", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetAcceleratorToMacrocell(); } });
   c.push_back({ "no-accelerator", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetAcceleratorToNone(); } });
-  c.push_back({ "environment-texture", Input::Head, Shaded,
-    [](Objects& o) { o.mapper->SetEnvironmentTexture(o.environment); } });
+  c.push_back(
+    { "environment-texture", Input::Head, Shaded, [](Objects& o) { o.mapper->SetEnvironmentTexture(o.environment); } });
   c.push_back({ "environment-intensity", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       Shaded(o);
       o.mapper->SetEnvironmentTexture(o.environment);
     },
     [](Objects& o) { o.mapper->SetEnvironmentIntensity(3.0); } });
   c.push_back({ "environment-texels", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       Shaded(o);
       o.mapper->SetEnvironmentTexture(o.environment);
     },
-    [](Objects& o) {
+    [](Objects& o)
+    {
       vtkImageData* sky = vtkImageData::SafeDownCast(o.environment->GetInputDataObject(0, 0));
       static_cast<float*>(sky->GetScalarPointer())[0] = 20.f;
       sky->Modified();
     } });
-  c.push_back({ "clipping-plane", Input::Head, HeadFunctions,
-    [](Objects& o) { o.mapper->AddClippingPlane(o.plane); } });
+  c.push_back(
+    { "clipping-plane", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->AddClippingPlane(o.plane); } });
   c.push_back({ "clipping-plane-moved", Input::Head,
-    [](Objects& o) {
+    [](Objects& o)
+    {
       HeadFunctions(o);
       o.mapper->AddClippingPlane(o.plane);
     },
-    [](Objects& o) {
+    [](Objects& o)
+    {
       const double* origin = o.plane->GetOrigin();
       o.plane->SetOrigin(origin[0] + 20, origin[1], origin[2]);
     } });
-  c.push_back({ "cropping", Input::Head, HeadFunctions, [](Objects& o) {
-                 const double* b = o.mapper->GetBounds();
-                 o.mapper->SetCroppingRegionPlanes(b[0], 0.5 * (b[0] + b[1]), b[2], b[3], b[4], b[5]);
-                 o.mapper->SetCroppingRegionFlagsToSubVolume();
-                 o.mapper->CroppingOn();
-               } });
-  c.push_back({ "exposure", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetExposure(2.0); }, false,
-    Work::Display });
+  c.push_back({ "cropping", Input::Head, HeadFunctions,
+    [](Objects& o)
+    {
+      const double* b = o.mapper->GetBounds();
+      o.mapper->SetCroppingRegionPlanes(b[0], 0.5 * (b[0] + b[1]), b[2], b[3], b[4], b[5]);
+      o.mapper->SetCroppingRegionFlagsToSubVolume();
+      o.mapper->CroppingOn();
+    } });
+  c.push_back(
+    { "exposure", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetExposure(2.0); }, false, Work::Display });
   c.push_back({ "nothing", Input::Head, HeadFunctions, [](Objects&) {}, false, Work::Display });
 
   // The work of the edits that do not only translate the property again.
   const std::map<std::string, Work> work = { { "gradient-opacity-enabled", Work::Rebuild },
-    { "gradient-opacity-disabled", Work::Rebuild },
-    { "independent-components-off", Work::Rebuild }, { "independent-components-on", Work::Rebuild },
-    { "component-gradient-opacity", Work::Rebuild }, { "label-gradient-opacity", Work::Rebuild },
-    { "mask-binary", Work::Rebuild }, { "seed", Work::Restart }, { "maximum-bounces", Work::Restart },
-    { "shadow-extinction-scale", Work::Restart }, { "sampler", Work::Restart },
+    { "gradient-opacity-disabled", Work::Rebuild }, { "independent-components-off", Work::Rebuild },
+    { "independent-components-on", Work::Rebuild }, { "component-gradient-opacity", Work::Rebuild },
+    { "label-gradient-opacity", Work::Rebuild }, { "mask-binary", Work::Rebuild }, { "seed", Work::Restart },
+    { "maximum-bounces", Work::Restart }, { "shadow-extinction-scale", Work::Restart }, { "sampler", Work::Restart },
     { "accelerator", Work::Accelerator }, { "no-accelerator", Work::Accelerator },
     { "environment-texture", Work::Restart }, { "environment-intensity", Work::Restart },
     { "environment-texels", Work::Restart }, { "clipping-plane", Work::Restart },
@@ -613,10 +635,10 @@ bool RunCase(const Case& c, const Inputs& in, vtkRenderWindow* window, vtkRender
     std::cout << differ << " of " << fresh.size() << " values differ from a fresh mapper's (largest difference "
               << largest << ")";
   std::cout << "; the edit changed " << changed << " values"
-            << (c.changesImage ? "" : " (documented as not used: 0 expected)") << "; A's scene builds +"
-            << done.builds << ", translations +" << done.translations << ", restarts +" << done.restarts
-            << ", grid builds +" << done.gridBuilds << ", grid refits +" << done.gridRefits << " ("
-            << WorkName(c.work) << (WorkAsExpected(c.work, done) ? ")" : " expected)") << "\n";
+            << (c.changesImage ? "" : " (documented as not used: 0 expected)") << "; A's scene builds +" << done.builds
+            << ", translations +" << done.translations << ", restarts +" << done.restarts << ", grid builds +"
+            << done.gridBuilds << ", grid refits +" << done.gridRefits << " (" << WorkName(c.work)
+            << (WorkAsExpected(c.work, done) ? ")" : " expected)") << "\n";
   if (before.empty() || edited.empty() || fresh.empty())
     std::cout << "     a render did not accumulate " << kSamples << " samples\n";
   return ok;
@@ -654,7 +676,7 @@ int main(int argc, char* argv[])
   reader->SetFileName((data + "/ct_head_headsq.nrrd").c_str());
   // Every other voxel (32 x 32 x 47): the scene builds of 90 mappers are
   // most of the test's time, and state is what it tests, not detail.
-  reader->Update();  // whole: the NRRD reader cannot read a part
+  reader->Update(); // whole: the NRRD reader cannot read a part
   vtkNew<vtkImageShrink3D> shrink;
   shrink->SetInputData(reader->GetOutput());
   shrink->SetShrinkFactors(2, 2, 2);

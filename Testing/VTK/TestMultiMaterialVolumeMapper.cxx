@@ -119,7 +119,8 @@ struct Options
 // The file names of a reference: REFERENCE.pfm (the mean) and its companions.
 std::string Companion(const std::string& mean, const std::string& suffix)
 {
-  const std::string stem = mean.size() > 4 && mean.substr(mean.size() - 4) == ".pfm" ? mean.substr(0, mean.size() - 4) : mean;
+  const std::string stem =
+    mean.size() > 4 && mean.substr(mean.size() - 4) == ".pfm" ? mean.substr(0, mean.size() - 4) : mean;
   return stem + suffix;
 }
 
@@ -206,8 +207,8 @@ std::vector<float> AccumulatedImage(vtkMultiMaterialVolumeMapper* mapper)
   mapper->GetAccumulatedImage(image);
   vtkFloatArray* values = vtkFloatArray::SafeDownCast(image->GetPointData()->GetScalars());
   if (!values || values->GetNumberOfTuples() != kSize * kSize || values->GetNumberOfComponents() != 4)
-    throw std::runtime_error("GetAccumulatedImage: no " + std::to_string(kSize) + " x " + std::to_string(kSize) +
-      " RGBA image");
+    throw std::runtime_error(
+      "GetAccumulatedImage: no " + std::to_string(kSize) + " x " + std::to_string(kSize) + " RGBA image");
   return std::vector<float>(values->GetPointer(0), values->GetPointer(0) + 4 * kSize * kSize);
 }
 
@@ -229,8 +230,8 @@ ImageEstimate RenderReplicates(vtkRenderWindow* window, vtkMultiMaterialVolumeMa
       window->Render();
     while (mapper->GetAccumulatedSamples() < samples && !mapper->IsConverged());
     if (mapper->GetAccumulatedSamples() != samples)
-      throw std::runtime_error("expected " + std::to_string(samples) + " samples, got " +
-        std::to_string(mapper->GetAccumulatedSamples()));
+      throw std::runtime_error(
+        "expected " + std::to_string(samples) + " samples, got " + std::to_string(mapper->GetAccumulatedSamples()));
     images.push_back(AccumulatedImage(mapper));
     if (r == 0)
       afterFirst();
@@ -315,13 +316,15 @@ int main(int argc, char* argv[])
   if (!ParseOptions(argc, argv, options))
   {
     const bool help = argc >= 2 && std::string(argv[1]) == "--help";
-    (help ? std::cout : std::cerr) << "usage: " << argv[0]
-              << " ct-bone|oblique|labels|rgba|mesh -D DATA -V REFERENCE.pfm [-T TEMP]\n"
-                 "    [--replicates R (" << kReplicates << ")] [--samples N (" << kSamples
-              << ")] [--samples-per-render K (N)] [--first-seed S (1)]\n"
-                 "    [--sampler sobol|independent (sobol)] [--accelerator octree|macrocell|none (octree)]\n"
-                 "    [--update-reference (or MMRTM_UPDATE_BASELINES=1): render "
-              << kReferenceReplicates << " x " << kReferenceSamples << " samples and rewrite the reference]\n";
+    (help ? std::cout : std::cerr)
+      << "usage: " << argv[0]
+      << " ct-bone|oblique|labels|rgba|mesh -D DATA -V REFERENCE.pfm [-T TEMP]\n"
+         "    [--replicates R ("
+      << kReplicates << ")] [--samples N (" << kSamples
+      << ")] [--samples-per-render K (N)] [--first-seed S (1)]\n"
+         "    [--sampler sobol|independent (sobol)] [--accelerator octree|macrocell|none (octree)]\n"
+         "    [--update-reference (or MMRTM_UPDATE_BASELINES=1): render "
+      << kReferenceReplicates << " x " << kReferenceSamples << " samples and rewrite the reference]\n";
     return help ? 0 : 2;
   }
   const std::string& testCase = options.testCase;
@@ -431,7 +434,7 @@ int main(int argc, char* argv[])
     sphereActor->GetProperty()->SetColor(0.2, 0.8, 0.3);
     renderer->AddActor(sphereActor);
   }
-  const double background[3] = { 0.15, 0.25, 0.55 };  // unlike any grey, so dark shading still counts
+  const double background[3] = { 0.15, 0.25, 0.55 }; // unlike any grey, so dark shading still counts
   renderer->SetBackground(background[0], background[1], background[2]);
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
@@ -448,7 +451,7 @@ int main(int argc, char* argv[])
   }
   else
   {
-    renderer->GetActiveCamera()->Elevation(-80);  // the face (the data's -z side) toward the camera
+    renderer->GetActiveCamera()->Elevation(-80); // the face (the data's -z side) toward the camera
   }
   renderer->GetActiveCamera()->OrthogonalizeViewUp();
   renderer->ResetCamera();
@@ -466,7 +469,8 @@ int main(int argc, char* argv[])
     volume->SetMapper(mapper);
   }
   bool coverageAgrees = true;
-  auto compareCoverage = [&]() {
+  auto compareCoverage = [&]()
+  {
     if (!checkCoverage)
       return;
     const std::vector<bool> covered = Coverage(window, background);
@@ -488,8 +492,8 @@ int main(int argc, char* argv[])
   {
     if (options.update)
     {
-      const ImageEstimate reference = RenderReplicates(window, mapper, kReferenceReplicates, kReferenceSamples,
-        0, kReferenceFirstSeed, [] {});
+      const ImageEstimate reference =
+        RenderReplicates(window, mapper, kReferenceReplicates, kReferenceSamples, 0, kReferenceFirstSeed, [] {});
       WritePFM(options.reference, kSize, kSize, reference.mean);
       WritePFM(Companion(options.reference, "_variance.pfm"), kSize, kSize, reference.variance);
       std::ofstream(Companion(options.reference, ".json"))
@@ -512,8 +516,8 @@ int main(int argc, char* argv[])
     }
 
     const Reference reference = ReadReference(options.reference);
-    ImageEstimate test = RenderReplicates(window, mapper, options.replicates, options.samples,
-      options.samplesPerRender, options.firstSeed, compareCoverage);
+    ImageEstimate test = RenderReplicates(window, mapper, options.replicates, options.samples, options.samplesPerRender,
+      options.firstSeed, compareCoverage);
     // The last replicate's screenshot, the mean and its variance, to look at.
     if (!options.temp.empty())
     {

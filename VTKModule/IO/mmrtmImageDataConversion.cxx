@@ -9,48 +9,60 @@
 
 #include "mmrtmVolumeLoaderInternal.h"
 
-namespace mmrtm {
-namespace {
+namespace mmrtm
+{
+namespace
+{
 
 // One component of an interleaved array, as a contiguous copy.
 template <typename T>
-std::vector<T> ExtractComponent(const T* data, int64_t tuples, int components, int component) {
+std::vector<T> ExtractComponent(const T* data, int64_t tuples, int components, int component)
+{
   std::vector<T> out((size_t)tuples);
-  for (int64_t i = 0; i < tuples; ++i) out[(size_t)i] = data[i * components + component];
+  for (int64_t i = 0; i < tuples; ++i)
+    out[(size_t)i] = data[i * components + component];
   return out;
 }
 
-}  // namespace
+} // namespace
 
-HostVolume ImageDataToHostVolume(vtkImageData* image, vtkDataArray* scalars, int component, const std::string& name,
-                                 Interpolation interpolation) {
-  if (!image) throw InputError(name + ": no input image");
+HostVolume ImageDataToHostVolume(
+  vtkImageData* image, vtkDataArray* scalars, int component, const std::string& name, Interpolation interpolation)
+{
+  if (!image)
+    throw InputError(name + ": no input image");
   vtkDataArray* a = scalars ? scalars : image->GetPointData()->GetScalars();
-  if (!a) throw InputError(name + ": the input image has no point scalars");
+  if (!a)
+    throw InputError(name + ": the input image has no point scalars");
   const int components = a->GetNumberOfComponents();
   if (component < 0 || component >= components)
-    throw InputError(name + ": component " + std::to_string(component) + " requested, the scalars have " +
-                     std::to_string(components));
+    throw InputError(
+      name + ": component " + std::to_string(component) + " requested, the scalars have " + std::to_string(components));
   HostVolume out;
   out.name = name;
   out.source = name;
   out.interpolation = interpolation;
   const int* d = image->GetDimensions();
-  out.dims = {d[0], d[1], d[2]};
+  out.dims = { d[0], d[1], d[2] };
   if (a->GetNumberOfTuples() != out.VoxelCount())
     throw InputError(name + ": the scalars hold " + std::to_string(a->GetNumberOfTuples()) + " tuples for " +
-                     std::to_string(out.VoxelCount()) + " points");
+      std::to_string(out.VoxelCount()) + " points");
   const SourceType type = SourceTypeOfVtk(a->GetDataType(), name);
-  if (components == 1) {
+  if (components == 1)
+  {
     StoreVoxels(a->GetVoidPointer(0), type, out.VoxelCount(), Rescale{}, out);
-  } else {
-    switch (a->GetDataType()) {
+  }
+  else
+  {
+    switch (a->GetDataType())
+    {
       vtkTemplateMacro({
-        const auto values = ExtractComponent(static_cast<const VTK_TT*>(a->GetVoidPointer(0)), out.VoxelCount(),
-                                             components, component);
+        const auto values =
+          ExtractComponent(static_cast<const VTK_TT*>(a->GetVoidPointer(0)), out.VoxelCount(), components, component);
         StoreVoxels(values.data(), type, out.VoxelCount(), Rescale{}, out);
       });
-      default: throw InputError(name + ": unsupported scalar type");
+      default:
+        throw InputError(name + ": unsupported scalar type");
     }
   }
   out.indexToWorld = VtkImageIndexToWorld(image);
@@ -58,4 +70,4 @@ HostVolume ImageDataToHostVolume(vtkImageData* image, vtkDataArray* scalars, int
   return out;
 }
 
-}  // namespace mmrtm
+} // namespace mmrtm

@@ -10,13 +10,14 @@
 class vtkDataArray;
 class vtkImageData;
 
-namespace mmrtm {
+namespace mmrtm
+{
 
 // Copies component `component` of `scalars` (the image's point scalars when
 // null) into a HostVolume; its indexToWorld is the image's own geometry
 // (origin, spacing, direction, extent). Throws InputError naming `name` for
 // an image without scalars, a missing component or a type it cannot hold.
-HostVolume ImageDataToHostVolume(vtkImageData* image, vtkDataArray* scalars, int component, const std::string& name,
-                                 Interpolation interpolation);
+HostVolume ImageDataToHostVolume(
+  vtkImageData* image, vtkDataArray* scalars, int component, const std::string& name, Interpolation interpolation);
 
-}  // namespace mmrtm
+} // namespace mmrtm

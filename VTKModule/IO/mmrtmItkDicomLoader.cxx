@@ -29,67 +29,84 @@
 
 namespace fs = std::filesystem;
 
-namespace mmrtm {
-namespace {
+namespace mmrtm
+{
+namespace
+{
 
 const gdcm::Tag kSeriesUid(0x0020, 0x000e), kSeriesDescription(0x0008, 0x103e), kModality(0x0008, 0x0060),
-    kPosition(0x0020, 0x0032), kOrientation(0x0020, 0x0037), kPixelSpacing(0x0028, 0x0030), kRows(0x0028, 0x0010),
-    kColumns(0x0028, 0x0011), kFrames(0x0028, 0x0008), kSamplesPerPixel(0x0028, 0x0002),
-    kGantryTilt(0x0018, 0x1120), kBitsAllocated(0x0028, 0x0100), kTransferSyntax(0x0002, 0x0010);
+  kPosition(0x0020, 0x0032), kOrientation(0x0020, 0x0037), kPixelSpacing(0x0028, 0x0030), kRows(0x0028, 0x0010),
+  kColumns(0x0028, 0x0011), kFrames(0x0028, 0x0008), kSamplesPerPixel(0x0028, 0x0002), kGantryTilt(0x0018, 0x1120),
+  kBitsAllocated(0x0028, 0x0100), kTransferSyntax(0x0002, 0x0010);
 
 // What one file's header says; the pixels are read later.
-struct SliceHeader {
+struct SliceHeader
+{
   std::string file;
   std::string uid, description, modality;
   std::string transferSyntax;
   int rows = 0, columns = 0, frames = 1, samples = 1, bitsAllocated = 16;
   std::vector<double> position, orientation, pixelSpacing;
   double gantryTilt = 0.0;
-  double along = 0.0;  // position along the slice normal
+  double along = 0.0; // position along the slice normal
 };
 
-std::string FileName(const std::string& path) { return fs::path(path).filename().string(); }
+std::string FileName(const std::string& path)
+{
+  return fs::path(path).filename().string();
+}
 
-std::string Str(double v, const char* format = "%.4g") {
+std::string Str(double v, const char* format = "%.4g")
+{
   char text[32];
   std::snprintf(text, sizeof text, format, v);
   return text;
 }
 
 // DICOM multi-valued strings: "a\b\c", padded with spaces or NULs.
-std::vector<double> Numbers(const char* value) {
+std::vector<double> Numbers(const char* value)
+{
   std::string text = value ? value : "";
   std::replace(text.begin(), text.end(), '\\', ' ');
   std::replace(text.begin(), text.end(), '\0', ' ');
   return ParseNumbers(text);
 }
 
-std::string Text(const char* value) {
+std::string Text(const char* value)
+{
   std::string text = value ? value : "";
   return Trim(text.substr(0, text.find('\0')));
 }
 
 // The header of every DICOM image file in the folder (not recursive).
-std::vector<SliceHeader> ScanFolder(const std::string& folder) {
+std::vector<SliceHeader> ScanFolder(const std::string& folder)
+{
   std::error_code ec;
-  if (!fs::is_directory(folder, ec)) throw InputError(folder + ": not a folder");
+  if (!fs::is_directory(folder, ec))
+    throw InputError(folder + ": not a folder");
   gdcm::Directory directory;
   const unsigned count = directory.Load(folder, false);
-  if (count == 0) throw InputError(folder + ": the folder holds no files (expected the DICOM files of a series)");
+  if (count == 0)
+    throw InputError(folder + ": the folder holds no files (expected the DICOM files of a series)");
 
-  for (const std::string& file : directory.GetFilenames()) {
+  for (const std::string& file : directory.GetFilenames())
+  {
     const std::string problem = CheckDicomElementLengths(file);
-    if (!problem.empty()) throw InputError(folder + ": " + FileName(file) + ": " + problem);
+    if (!problem.empty())
+      throw InputError(folder + ": " + FileName(file) + ": " + problem);
   }
   gdcm::Scanner scanner;
-  for (const gdcm::Tag& t : {kSeriesUid, kSeriesDescription, kModality, kPosition, kOrientation, kPixelSpacing,
-                             kRows, kColumns, kFrames, kSamplesPerPixel, kGantryTilt, kBitsAllocated, kTransferSyntax})
+  for (const gdcm::Tag& t : { kSeriesUid, kSeriesDescription, kModality, kPosition, kOrientation, kPixelSpacing, kRows,
+         kColumns, kFrames, kSamplesPerPixel, kGantryTilt, kBitsAllocated, kTransferSyntax })
     scanner.AddTag(t);
-  if (!scanner.Scan(directory.GetFilenames())) throw InputError(folder + ": cannot scan the folder's files");
+  if (!scanner.Scan(directory.GetFilenames()))
+    throw InputError(folder + ": cannot scan the folder's files");
 
   std::vector<SliceHeader> slices;
-  for (const std::string& file : directory.GetFilenames()) {
-    if (!scanner.IsKey(file.c_str())) continue;  // not DICOM
+  for (const std::string& file : directory.GetFilenames())
+  {
+    if (!scanner.IsKey(file.c_str()))
+      continue; // not DICOM
     SliceHeader h;
     h.file = file;
     h.uid = Text(scanner.GetValue(file.c_str(), kSeriesUid));
@@ -100,14 +117,19 @@ std::vector<SliceHeader> ScanFolder(const std::string& folder) {
                               frames = Numbers(scanner.GetValue(file.c_str(), kFrames)),
                               samples = Numbers(scanner.GetValue(file.c_str(), kSamplesPerPixel)),
                               tilt = Numbers(scanner.GetValue(file.c_str(), kGantryTilt));
-    if (rows.empty() || columns.empty()) continue;  // no image (a report, a structure set, DICOMDIR)
+    if (rows.empty() || columns.empty())
+      continue; // no image (a report, a structure set, DICOMDIR)
     h.rows = (int)rows[0];
     h.columns = (int)columns[0];
-    if (!frames.empty()) h.frames = (int)frames[0];
-    if (!samples.empty()) h.samples = (int)samples[0];
-    if (!tilt.empty()) h.gantryTilt = tilt[0];
+    if (!frames.empty())
+      h.frames = (int)frames[0];
+    if (!samples.empty())
+      h.samples = (int)samples[0];
+    if (!tilt.empty())
+      h.gantryTilt = tilt[0];
     const std::vector<double> bits = Numbers(scanner.GetValue(file.c_str(), kBitsAllocated));
-    if (!bits.empty()) h.bitsAllocated = (int)bits[0];
+    if (!bits.empty())
+      h.bitsAllocated = (int)bits[0];
     h.transferSyntax = Text(scanner.GetValue(file.c_str(), kTransferSyntax));
     h.position = Numbers(scanner.GetValue(file.c_str(), kPosition));
     h.orientation = Numbers(scanner.GetValue(file.c_str(), kOrientation));
@@ -120,125 +142,151 @@ std::vector<SliceHeader> ScanFolder(const std::string& folder) {
 }
 
 // Groups the slices by SeriesInstanceUID, most slices first.
-std::vector<std::vector<SliceHeader>> GroupSeries(std::vector<SliceHeader> slices) {
+std::vector<std::vector<SliceHeader>> GroupSeries(std::vector<SliceHeader> slices)
+{
   std::map<std::string, std::vector<SliceHeader>> byUid;
-  for (SliceHeader& s : slices) byUid[s.uid].push_back(std::move(s));
+  for (SliceHeader& s : slices)
+    byUid[s.uid].push_back(std::move(s));
   std::vector<std::vector<SliceHeader>> series;
-  for (auto& [uid, list] : byUid) series.push_back(std::move(list));
+  for (auto& [uid, list] : byUid)
+    series.push_back(std::move(list));
   std::stable_sort(series.begin(), series.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
   return series;
 }
 
-DicomSeriesSummary Summarize(const std::vector<SliceHeader>& series) {
+DicomSeriesSummary Summarize(const std::vector<SliceHeader>& series)
+{
   const SliceHeader& s = series.front();
-  return {s.uid, s.description, s.modality, (int)series.size(), s.rows, s.columns};
+  return { s.uid, s.description, s.modality, (int)series.size(), s.rows, s.columns };
 }
 
-std::string Describe(const DicomSeriesSummary& s) {
+std::string Describe(const DicomSeriesSummary& s)
+{
   return (s.uid.empty() ? std::string("(no SeriesInstanceUID)") : s.uid) + " (" + std::to_string(s.slices) +
-         " slice(s) of " + std::to_string(s.columns) + " x " + std::to_string(s.rows) +
-         (s.description.empty() ? "" : ", \"" + s.description + "\"") + (s.modality.empty() ? "" : ", " + s.modality) +
-         ")";
+    " slice(s) of " + std::to_string(s.columns) + " x " + std::to_string(s.rows) +
+    (s.description.empty() ? "" : ", \"" + s.description + "\"") + (s.modality.empty() ? "" : ", " + s.modality) + ")";
 }
 
-std::string DescribeAll(const std::vector<std::vector<SliceHeader>>& series) {
+std::string DescribeAll(const std::vector<std::vector<SliceHeader>>& series)
+{
   std::string list;
-  for (const auto& s : series) list += "\n  " + Describe(Summarize(s));
+  for (const auto& s : series)
+    list += "\n  " + Describe(Summarize(s));
   return list;
 }
 
 // The series named by `selector` (UID, else description, case-insensitive),
 // or the largest one when the selector is empty.
-const std::vector<SliceHeader>& ChooseSeries(const std::string& folder,
-                                             const std::vector<std::vector<SliceHeader>>& series,
-                                             const VolumeLoadOptions& options) {
-  if (options.series.empty()) {
+const std::vector<SliceHeader>& ChooseSeries(
+  const std::string& folder, const std::vector<std::vector<SliceHeader>>& series, const VolumeLoadOptions& options)
+{
+  if (options.series.empty())
+  {
     if (series.size() > 1)
-      Warn(options, folder + " holds " + std::to_string(series.size()) + " series; reading the largest, " +
-                        Describe(Summarize(series[0])) + ". Choose another by its UID or description:" +
-                        DescribeAll(series));
+      Warn(options,
+        folder + " holds " + std::to_string(series.size()) + " series; reading the largest, " +
+          Describe(Summarize(series[0])) + ". Choose another by its UID or description:" + DescribeAll(series));
     return series[0];
   }
   for (const auto& s : series)
-    if (s.front().uid == options.series) return s;
+    if (s.front().uid == options.series)
+      return s;
   const std::vector<SliceHeader>* match = nullptr;
   for (const auto& s : series)
-    if (ToLower(s.front().description) == ToLower(options.series)) {
+    if (ToLower(s.front().description) == ToLower(options.series))
+    {
       if (match)
         throw InputError(folder + ": more than one series is described as \"" + options.series +
-                         "\"; choose one by its UID:" + DescribeAll(series));
+          "\"; choose one by its UID:" + DescribeAll(series));
       match = &s;
     }
   if (!match)
     throw InputError(folder + ": no series with the UID or description \"" + options.series +
-                     "\"; the folder holds:" + DescribeAll(series));
+      "\"; the folder holds:" + DescribeAll(series));
   return *match;
 }
 
-Vec3d Vec(const std::vector<double>& v, size_t first) { return {v[first], v[first + 1], v[first + 2]}; }
+Vec3d Vec(const std::vector<double>& v, size_t first)
+{
+  return { v[first], v[first + 1], v[first + 2] };
+}
 
-double Norm(const Vec3d& v) { return std::sqrt(Dot(v, v)); }
+double Norm(const Vec3d& v)
+{
+  return std::sqrt(Dot(v, v));
+}
 
 // Every slice must have the same size, pixel spacing and orientation, and a
 // position: the grid is built from them.
-void CheckSlicesAgree(const std::string& folder, const std::vector<SliceHeader>& slices) {
+void CheckSlicesAgree(const std::string& folder, const std::vector<SliceHeader>& slices)
+{
   const SliceHeader& first = slices.front();
-  for (const SliceHeader& s : slices) {
+  for (const SliceHeader& s : slices)
+  {
     const std::string where = folder + ": " + FileName(s.file);
     if (s.frames > 1)
       throw InputError(where + " holds " + std::to_string(s.frames) +
-                       " frames; multi-frame DICOM files are not supported (one slice per file)");
+        " frames; multi-frame DICOM files are not supported (one slice per file)");
     if (s.samples != 1)
-      throw InputError(where + " has " + std::to_string(s.samples) +
-                       " samples per pixel (colour); only greyscale series are volumes");
-    if (s.position.size() != 3) throw InputError(where + " has no ImagePositionPatient: its slice cannot be placed");
-    if (s.orientation.size() != 6) throw InputError(where + " has no ImageOrientationPatient");
+      throw InputError(
+        where + " has " + std::to_string(s.samples) + " samples per pixel (colour); only greyscale series are volumes");
+    if (s.position.size() != 3)
+      throw InputError(where + " has no ImagePositionPatient: its slice cannot be placed");
+    if (s.orientation.size() != 6)
+      throw InputError(where + " has no ImageOrientationPatient");
     if (s.pixelSpacing.size() != 2 || !(s.pixelSpacing[0] > 0) || !(s.pixelSpacing[1] > 0))
       throw InputError(where + " has no valid PixelSpacing");
     if (s.rows != first.rows || s.columns != first.columns)
       throw InputError(where + " is " + std::to_string(s.columns) + " x " + std::to_string(s.rows) + ", but " +
-                       FileName(first.file) + " is " + std::to_string(first.columns) + " x " +
-                       std::to_string(first.rows) + ": the slices of a series must have one size");
+        FileName(first.file) + " is " + std::to_string(first.columns) + " x " + std::to_string(first.rows) +
+        ": the slices of a series must have one size");
     for (int a = 0; a < 2; ++a)
       if (std::abs(s.pixelSpacing[a] - first.pixelSpacing[a]) > 1e-4 * first.pixelSpacing[a])
         throw InputError(where + " has PixelSpacing " + Str(s.pixelSpacing[0]) + "\\" + Str(s.pixelSpacing[1]) +
-                         " but " + FileName(first.file) + " has " + Str(first.pixelSpacing[0]) + "\\" +
-                         Str(first.pixelSpacing[1]) + ": inconsistent pixel spacing within the series");
+          " but " + FileName(first.file) + " has " + Str(first.pixelSpacing[0]) + "\\" + Str(first.pixelSpacing[1]) +
+          ": inconsistent pixel spacing within the series");
     for (int a = 0; a < 6; ++a)
       if (std::abs(s.orientation[a] - first.orientation[a]) > 1e-4)
         throw InputError(where + " has another ImageOrientationPatient than " + FileName(first.file) +
-                         ": the slices of a series must be parallel");
+          ": the slices of a series must be parallel");
   }
 }
 
 // Sorts the slices along the normal and checks that they lie on one line
 // (a tilt moves each slice sideways by the same amount) with distinct positions.
-void SortSlices(const std::string& folder, std::vector<SliceHeader>& slices, const Vec3d& normal) {
-  for (SliceHeader& s : slices) s.along = Dot(Vec(s.position, 0), normal);
+void SortSlices(const std::string& folder, std::vector<SliceHeader>& slices, const Vec3d& normal)
+{
+  for (SliceHeader& s : slices)
+    s.along = Dot(Vec(s.position, 0), normal);
   std::sort(slices.begin(), slices.end(), [](const SliceHeader& a, const SliceHeader& b) { return a.along < b.along; });
   for (size_t i = 1; i < slices.size(); ++i)
     if (slices[i].along - slices[i - 1].along < 1e-3)
       throw InputError(folder + ": " + FileName(slices[i - 1].file) + " and " + FileName(slices[i].file) +
-                       " lie at the same position (" + Str(slices[i].along) +
-                       " mm along the normal): two acquisitions in one series, or a duplicated file");
+        " lie at the same position (" + Str(slices[i].along) +
+        " mm along the normal): two acquisitions in one series, or a duplicated file");
 }
 
 // The slice positions along the normal, relative to the first slice.
-std::vector<double> Offsets(const std::vector<SliceHeader>& slices) {
+std::vector<double> Offsets(const std::vector<SliceHeader>& slices)
+{
   std::vector<double> d;
-  for (const SliceHeader& s : slices) d.push_back(s.along - slices.front().along);
+  for (const SliceHeader& s : slices)
+    d.push_back(s.along - slices.front().along);
   return d;
 }
 
-double MedianGap(const std::vector<double>& d) {
+double MedianGap(const std::vector<double>& d)
+{
   std::vector<double> gaps;
-  for (size_t i = 1; i < d.size(); ++i) gaps.push_back(d[i] - d[i - 1]);
+  for (size_t i = 1; i < d.size(); ++i)
+    gaps.push_back(d[i] - d[i - 1]);
   std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
   return gaps[gaps.size() / 2];
 }
 
 // Decodes one slice (rescaled to modality units) into `dst` (rows x columns floats).
-void ReadSlicePixels(const std::string& folder, const SliceHeader& s, float* dst) {
+void ReadSlicePixels(const std::string& folder, const SliceHeader& s, float* dst)
+{
   // GDCM pads a cut-short uncompressed file with zeros without a word; a file
   // too small for its pixels is damaged.
   std::error_code ec;
@@ -247,42 +295,48 @@ void ReadSlicePixels(const std::string& folder, const SliceHeader& s, float* dst
   const bool uncompressed = s.transferSyntax.empty() || IsUncompressedTransferSyntax(s.transferSyntax);
   if (uncompressed && (double)fs::file_size(s.file, ec) < pixelBytes)
     throw InputError(folder + ": " + FileName(s.file) + " is " + std::to_string(fs::file_size(s.file, ec)) +
-                     " bytes, too short for its " + std::to_string((long long)pixelBytes) +
-                     " bytes of pixel data (truncated?)");
+      " bytes, too short for its " + std::to_string((long long)pixelBytes) + " bytes of pixel data (truncated?)");
   using Image = itk::Image<float, 3>;
   auto io = itk::GDCMImageIO::New();
   auto reader = itk::ImageFileReader<Image>::New();
   reader->SetImageIO(io);
   reader->SetFileName(s.file);
-  try {
+  try
+  {
     reader->Update();
-  } catch (const itk::ExceptionObject& e) {
-    throw InputError(folder + ": " + FileName(s.file) + ": cannot decode its pixel data (truncated or corrupt?): " +
-                     Trim(e.GetDescription()));
+  }
+  catch (const itk::ExceptionObject& e)
+  {
+    throw InputError(folder + ": " + FileName(s.file) +
+      ": cannot decode its pixel data (truncated or corrupt?): " + Trim(e.GetDescription()));
   }
   const Image* image = reader->GetOutput();
   const auto size = image->GetLargestPossibleRegion().GetSize();
   if ((int)size[0] != s.columns || (int)size[1] != s.rows || size[2] != 1)
     throw InputError(folder + ": " + FileName(s.file) + ": decoded " + std::to_string(size[0]) + " x " +
-                     std::to_string(size[1]) + " x " + std::to_string(size[2]) + " pixels, header says " +
-                     std::to_string(s.columns) + " x " + std::to_string(s.rows));
+      std::to_string(size[1]) + " x " + std::to_string(size[2]) + " pixels, header says " + std::to_string(s.columns) +
+      " x " + std::to_string(s.rows));
   std::copy(image->GetBufferPointer(), image->GetBufferPointer() + (size_t)s.rows * s.columns, dst);
 }
 
 // Linear interpolation of the slices (at offsets d) onto `count` slices
 // `spacing` apart. Integer input stays integer (rounded), so CT keeps int16.
 std::vector<float> ResampleSlices(const std::vector<float>& voxels, int64_t sliceVoxels, const std::vector<double>& d,
-                                  int count, double spacing, bool integers) {
+  int count, double spacing, bool integers)
+{
   std::vector<float> out((size_t)(sliceVoxels * count));
   size_t k = 0;
-  for (int j = 0; j < count; ++j) {
+  for (int j = 0; j < count; ++j)
+  {
     const double t = std::min(j * spacing, d.back());
-    while (k + 2 < d.size() && d[k + 1] < t) ++k;
+    while (k + 2 < d.size() && d[k + 1] < t)
+      ++k;
     const float w = (float)std::clamp((t - d[k]) / (d[k + 1] - d[k]), 0.0, 1.0);
     const float* a = voxels.data() + k * sliceVoxels;
     const float* b = a + sliceVoxels;
     float* o = out.data() + j * sliceVoxels;
-    for (int64_t i = 0; i < sliceVoxels; ++i) {
+    for (int64_t i = 0; i < sliceVoxels; ++i)
+    {
       const float v = a[i] + w * (b[i] - a[i]);
       o[i] = integers ? std::nearbyint(v) : v;
     }
@@ -290,18 +344,24 @@ std::vector<float> ResampleSlices(const std::vector<float>& voxels, int64_t slic
   return out;
 }
 
-}  // namespace
+} // namespace
 
-bool DicomDecodesCompressedSyntaxes() { return true; }
+bool DicomDecodesCompressedSyntaxes()
+{
+  return true;
+}
 
-std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder) {
+std::vector<DicomSeriesSummary> ListDicomSeries(const std::string& folder)
+{
   gdcm::Trace::WarningOff();
   std::vector<DicomSeriesSummary> list;
-  for (const auto& s : GroupSeries(ScanFolder(folder))) list.push_back(Summarize(s));
+  for (const auto& s : GroupSeries(ScanFolder(folder)))
+    list.push_back(Summarize(s));
   return list;
 }
 
-void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoadOptions& options) {
+void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoadOptions& options)
+{
   // GDCM warns on stderr about harmless quirks (one FrameOfReferenceUID per
   // file in an anonymised series) and reports decoding errors there too; the
   // checks and InputErrors here say what matters, naming the file.
@@ -321,7 +381,8 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoa
   const double normalLength = Norm(normal);
   if (!(normalLength > 0.5))
     throw InputError(folder + ": " + FileName(first.file) + " has a degenerate ImageOrientationPatient");
-  for (double& v : normal) v /= normalLength;
+  for (double& v : normal)
+    v /= normalLength;
   SortSlices(folder, slices, normal);
   const int n = (int)slices.size();
   const int64_t sliceVoxels = (int64_t)first.rows * first.columns;
@@ -329,72 +390,89 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoa
   // Slice step: from the first to the last position. With a gantry tilt it
   // is oblique to the normal; keeping it (a sheared grid) puts each slice
   // where its ImagePositionPatient says, without resampling.
-  Vec3d step{0, 0, 0};
+  Vec3d step{ 0, 0, 0 };
   std::vector<double> d = Offsets(slices);
-  if (n == 1) {
-    step = normal;  // one slice: a unit step along the normal
-  } else {
-    for (int r = 0; r < 3; ++r) step[r] = (slices[n - 1].position[r] - first.position[r]) / d.back();
+  if (n == 1)
+  {
+    step = normal; // one slice: a unit step along the normal
+  }
+  else
+  {
+    for (int r = 0; r < 3; ++r)
+      step[r] = (slices[n - 1].position[r] - first.position[r]) / d.back();
     // step is now per mm along the normal; every slice must lie on that line.
-    for (const SliceHeader& s : slices) {
+    for (const SliceHeader& s : slices)
+    {
       const double t = s.along - first.along;
       double off = 0;
-      for (int r = 0; r < 3; ++r) off += std::pow(s.position[r] - (first.position[r] + t * step[r]), 2);
+      for (int r = 0; r < 3; ++r)
+        off += std::pow(s.position[r] - (first.position[r] + t * step[r]), 2);
       if (std::sqrt(off) > 0.1 * std::min(first.pixelSpacing[0], first.pixelSpacing[1]) + 1e-3)
         throw InputError(folder + ": " + FileName(s.file) + " is " + Str(std::sqrt(off)) +
-                         " mm off the line through the other slices' positions: not one stack of slices");
+          " mm off the line through the other slices' positions: not one stack of slices");
     }
   }
   const double tiltDegrees = std::acos(std::clamp(Dot(step, normal) / Norm(step), -1.0, 1.0)) * 180.0 / M_PI;
   if (tiltDegrees > 0.01)
-    Warn(options, folder + ": the slices are tilted by " + Str(tiltDegrees, "%.2f") +
-                      " degrees (gantry tilt; GantryDetectorTilt says " + Str(first.gantryTilt, "%.2f") +
-                      "); the volume keeps it as a shear of its grid, so every slice stays where it was acquired");
+    Warn(options,
+      folder + ": the slices are tilted by " + Str(tiltDegrees, "%.2f") +
+        " degrees (gantry tilt; GantryDetectorTilt says " + Str(first.gantryTilt, "%.2f") +
+        "); the volume keeps it as a shear of its grid, so every slice stays where it was acquired");
 
   // Uneven spacing (a missing slice, a variable-pitch scan): resample onto a
   // regular grid at the median spacing, so that no slice is misplaced.
   int outSlices = n;
   double spacing = 1.0;
   bool uneven = false;
-  if (n > 1) {
+  if (n > 1)
+  {
     spacing = MedianGap(d);
     for (int i = 1; i < n; ++i)
-      if (std::abs(d[i] - d[i - 1] - spacing) > 0.01 * spacing + 1e-3) uneven = true;
-    if (uneven) {
+      if (std::abs(d[i] - d[i - 1] - spacing) > 0.01 * spacing + 1e-3)
+        uneven = true;
+    if (uneven)
+    {
       outSlices = (int)std::lround(d.back() / spacing) + 1;
       spacing = d.back() / (outSlices - 1);
       double widest = 0;
       int widestAfter = 0;
       for (int i = 1; i < n; ++i)
-        if (d[i] - d[i - 1] > widest) widest = d[i] - d[i - 1], widestAfter = i - 1;
-      Warn(options, folder + ": the slices are not evenly spaced (gaps from " + Str(spacing) + " to " + Str(widest) +
-                        " mm; the widest after " + FileName(slices[widestAfter].file) +
-                        ", a missing slice?); resampled onto " + std::to_string(outSlices) + " slices " +
-                        Str(spacing) + " mm apart by linear interpolation between neighbouring slices");
-    } else {
+        if (d[i] - d[i - 1] > widest)
+          widest = d[i] - d[i - 1], widestAfter = i - 1;
+      Warn(options,
+        folder + ": the slices are not evenly spaced (gaps from " + Str(spacing) + " to " + Str(widest) +
+          " mm; the widest after " + FileName(slices[widestAfter].file) + ", a missing slice?); resampled onto " +
+          std::to_string(outSlices) + " slices " + Str(spacing) +
+          " mm apart by linear interpolation between neighbouring slices");
+    }
+    else
+    {
       spacing = d.back() / (n - 1);
     }
   }
 
   // Pixels: checked against the memory first (a float per voxel while
   // reading, then the stored type).
-  CheckMemoryAvailable(folder, 4.0 * sliceVoxels * ((double)n + (uneven ? outSlices : 0)) + 2.0 * sliceVoxels * outSlices,
-                       std::to_string(first.columns) + " x " + std::to_string(first.rows) + " x " +
-                           std::to_string(outSlices) + " voxels");
+  CheckMemoryAvailable(folder,
+    4.0 * sliceVoxels * ((double)n + (uneven ? outSlices : 0)) + 2.0 * sliceVoxels * outSlices,
+    std::to_string(first.columns) + " x " + std::to_string(first.rows) + " x " + std::to_string(outSlices) + " voxels");
   std::vector<float> voxels((size_t)(sliceVoxels * n));
-  for (int i = 0; i < n; ++i) ReadSlicePixels(folder, slices[i], voxels.data() + i * sliceVoxels);
-  if (uneven) {
+  for (int i = 0; i < n; ++i)
+    ReadSlicePixels(folder, slices[i], voxels.data() + i * sliceVoxels);
+  if (uneven)
+  {
     const bool integers = std::all_of(voxels.begin(), voxels.end(), [](float v) { return v == std::floor(v); });
     voxels = ResampleSlices(voxels, sliceVoxels, d, outSlices, spacing, integers);
   }
-  out.dims = {first.columns, first.rows, outSlices};
+  out.dims = { first.columns, first.rows, outSlices };
   StoreVoxels(voxels.data(), SourceType::Float32, (int64_t)voxels.size(), Rescale{}, out, /*narrowFloats=*/true);
 
   // index -> world: columns are the row direction x column spacing, the
   // column direction x row spacing, and the slice step (possibly oblique).
   Affine3 m;
-  const Vec3d sliceStep{step[0] * spacing, step[1] * spacing, step[2] * spacing};
-  for (int r = 0; r < 3; ++r) {
+  const Vec3d sliceStep{ step[0] * spacing, step[1] * spacing, step[2] * spacing };
+  for (int r = 0; r < 3; ++r)
+  {
     m.m[r][0] = (float)(row[r] * first.pixelSpacing[1]);
     m.m[r][1] = (float)(column[r] * first.pixelSpacing[0]);
     m.m[r][2] = (float)sliceStep[r];
@@ -403,4 +481,4 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoa
   out.indexToWorld = m;
 }
 
-}  // namespace mmrtm
+} // namespace mmrtm

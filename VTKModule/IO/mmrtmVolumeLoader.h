@@ -12,7 +12,8 @@
 
 #include "host_volume.h"
 
-namespace mmrtm {
+namespace mmrtm
+{
 
 // Loads a volume file or a DICOM folder into a HostVolume named `name`.
 //
@@ -42,10 +43,11 @@ namespace mmrtm {
 // missing path, an unknown extension, an unreadable, corrupt or truncated
 // file, an empty volume, more than one component per voxel, non-finite
 // voxels and folders without readable DICOM files.
-HostVolume LoadVolume(const std::string& path, const std::string& name = "scalars",
-                      Interpolation interpolation = Interpolation::Trilinear);
+HostVolume LoadVolume(
+  const std::string& path, const std::string& name = "scalars", Interpolation interpolation = Interpolation::Trilinear);
 
-struct VolumeLoadOptions {
+struct VolumeLoadOptions
+{
   Interpolation interpolation = Interpolation::Trilinear;
   // DICOM folders: the SeriesInstanceUID or the SeriesDescription of the
   // series to read; empty reads the series with the most slices.
@@ -58,7 +60,8 @@ struct VolumeLoadOptions {
 HostVolume LoadVolume(const std::string& path, const std::string& name, const VolumeLoadOptions& options);
 
 // One DICOM series of a folder, as ListDicomSeries reports it.
-struct DicomSeriesSummary {
+struct DicomSeriesSummary
+{
   std::string uid, description, modality;
   int slices = 0;
   int rows = 0, columns = 0;
@@ -77,4 +80,4 @@ bool DicomDecodesCompressedSyntaxes();
 // invesalius-examples package.
 std::string DefaultVolumePath();
 
-}  // namespace mmrtm
+} // namespace mmrtm

@@ -18,12 +18,13 @@ class vtkAlgorithm;
 class vtkDataArray;
 class vtkImageData;
 
-namespace mmrtm {
+namespace mmrtm
+{
 
 using Vec3d = std::array<double, 3>;
-using Mat3d = std::array<double, 9>;  // row-major; column c is the direction of index axis c
+using Mat3d = std::array<double, 9>; // row-major; column c is the direction of index axis c
 
-inline constexpr Mat3d kIdentity3 = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+inline constexpr Mat3d kIdentity3 = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
 
 // ---------------------------------------------------------------------------
 // Small helpers (mmrtmLoaderUtilities.cxx)
@@ -65,10 +66,23 @@ std::string CheckDicomElementLengths(const std::string& file);
 // ---------------------------------------------------------------------------
 
 // Voxel types as files store them, before the choice of a HostVolume type.
-enum class SourceType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
+enum class SourceType
+{
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Int64,
+  UInt64,
+  Float32,
+  Float64
+};
 
 // value = stored * slope + intercept (NIfTI scl_*, DICOM rescale).
-struct Rescale {
+struct Rescale
+{
   double slope = 1.0, intercept = 0.0;
   bool IsIdentity() const { return slope == 1.0 && intercept == 0.0; }
 };
@@ -77,8 +91,8 @@ struct Rescale {
 // rescale and choosing the voxel type by the rules in mmrtmVolumeLoader.h.
 // With narrowFloats, float32 voxels that are all integers (a DICOM slice read
 // as float) also take the smallest exact integer type.
-void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out,
-                 bool narrowFloats = false);
+void StoreVoxels(
+  const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out, bool narrowFloats = false);
 
 // Throws InputError naming `path` when `bytes` (the voxels about to be
 // allocated, described by `what`) exceed the memory this machine has
@@ -86,7 +100,12 @@ void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale resca
 void CheckMemoryAvailable(const std::string& path, double bytes, const std::string& what);
 
 // How voxel data is stored in a file, for CheckDeclaredVoxelBytes.
-enum class DataEncoding { Raw, Compressed, Text };
+enum class DataEncoding
+{
+  Raw,
+  Compressed,
+  Text
+};
 
 // Checks a header's promise of `declaredBytes` of voxels (`count` values)
 // against the `fileBytes` that are to hold them, before any reader allocates
@@ -95,8 +114,8 @@ enum class DataEncoding { Raw, Compressed, Text };
 // CheckMemoryAvailable. Throws InputError naming `path`: a truncated file or
 // a corrupt header ("sizes" that promise terabytes) is an error, not an
 // allocation attempt.
-void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
-                             DataEncoding encoding);
+void CheckDeclaredVoxelBytes(
+  const std::string& path, double declaredBytes, double count, double fileBytes, DataEncoding encoding);
 
 // A printf format that names the files of a series (NRRD's `data file:
 // <format> ...`, MetaImage's `ElementDataFile = <pattern> ...`): both
@@ -119,8 +138,9 @@ void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock);
 
 // Watches a reader, its executive and the output window for errors while it
 // lives. The output window is process-wide: loading is meant for one thread.
-class ReaderErrors {
- public:
+class ReaderErrors
+{
+public:
   explicit ReaderErrors(vtkAlgorithm* reader);
   ~ReaderErrors();
   ReaderErrors(const ReaderErrors&) = delete;
@@ -129,8 +149,8 @@ class ReaderErrors {
   // Throws InputError naming `path` if the reader reported an error.
   void ThrowIfFailed(const std::string& path) const;
 
- private:
-  struct Watch;  // the observers and the output window (VTK types): defined in the .cxx
+private:
+  struct Watch; // the observers and the output window (VTK types): defined in the .cxx
   std::unique_ptr<Watch> watch_;
 };
 
@@ -158,13 +178,16 @@ Affine3 VtkImageIndexToWorld(vtkImageData* image);
 // voxels and indexToWorld (LoadVolume sets the rest); bad input throws InputError.
 // ---------------------------------------------------------------------------
 
-void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);         // mmrtmNrrdLoader.cxx
-void LoadNifti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);        // mmrtmNiftiLoader.cxx
-void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);    // mmrtmMetaImageLoader.cxx
-void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);          // mmrtmVtkImageLoader.cxx
-void LoadLegacyVtk(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);    // mmrtmVtkImageLoader.cxx
+void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);  // mmrtmNrrdLoader.cxx
+void LoadNifti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options); // mmrtmNiftiLoader.cxx
+void LoadMetaImage(
+  const std::string& path, HostVolume& out, const VolumeLoadOptions& options);            // mmrtmMetaImageLoader.cxx
+void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options); // mmrtmVtkImageLoader.cxx
+void LoadLegacyVtk(
+  const std::string& path, HostVolume& out, const VolumeLoadOptions& options); // mmrtmVtkImageLoader.cxx
 // mmrtmItkDicomLoader.cxx with ITK, else mmrtmDicomLoader.cxx (VTK)
 void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoadOptions& options);
-void LoadInVesalius(const std::string& path, HostVolume& out, const VolumeLoadOptions& options);   // mmrtmInVesaliusLoader.cxx
+void LoadInVesalius(
+  const std::string& path, HostVolume& out, const VolumeLoadOptions& options); // mmrtmInVesaliusLoader.cxx
 
-}  // namespace mmrtm
+} // namespace mmrtm

@@ -16,10 +16,10 @@
 #ifndef vtkMultiMaterialVolumeReader_h
 #define vtkMultiMaterialVolumeReader_h
 
-#include "mmrtmIOModule.h"  // for export macro
+#include "mmrtmIOModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
-#include <string>  // for std::string
+#include <string> // for std::string
 
 class MMRTMIO_EXPORT vtkMultiMaterialVolumeReader : public vtkImageAlgorithm
 {

@@ -19,7 +19,8 @@ class vtkColorTransferFunction;
 class vtkPiecewiseFunction;
 class vtkVolumeProperty;
 
-namespace mmrtm {
+namespace mmrtm
+{
 
 // The function the property holds for `component`, or null where it holds
 // none (where VTK's getter would create one).
@@ -34,6 +35,6 @@ vtkSmartPointer<vtkPiecewiseFunction> DefaultScalarOpacity();
 vtkSmartPointer<vtkColorTransferFunction> DefaultRGBTransferFunction();
 vtkSmartPointer<vtkPiecewiseFunction> DefaultGrayTransferFunction();
 
-}  // namespace mmrtm
+} // namespace mmrtm
 
 #endif

@@ -22,19 +22,25 @@
 #include "mmrtmVolumePropertyFunctions.h"
 #include "scene_json.h"
 
-namespace mmrtm {
-namespace {
+namespace mmrtm
+{
+namespace
+{
 
 // Sample positions over [lo, hi] (one point when the range is empty).
-std::vector<float> Positions(std::array<float, 2> range) {
-  if (!(range[1] > range[0])) return {range[0]};
+std::vector<float> Positions(std::array<float, 2> range)
+{
+  if (!(range[1] > range[0]))
+    return { range[0] };
   std::vector<float> x(kTableSize);
-  for (int i = 0; i < kTableSize; ++i) x[i] = range[0] + (range[1] - range[0]) * (float)i / (kTableSize - 1);
+  for (int i = 0; i < kTableSize; ++i)
+    x[i] = range[0] + (range[1] - range[0]) * (float)i / (kTableSize - 1);
   return x;
 }
 
 int AddCurve(Scene& scene, const std::string& where, int proxy, const std::vector<float>& keys,
-             const std::vector<float>& values, int channels) {
+  const std::vector<float>& values, int channels)
+{
   TransferFunctionDesc tf;
   tf.where = where;
   tf.type = TFType::CCTF;
@@ -48,97 +54,123 @@ int AddCurve(Scene& scene, const std::string& where, int proxy, const std::vecto
 
 // VTK's opacity per unit distance as extinction: a slab `unit` thick
 // transmits 1 - alpha.
-float Extinction(double alpha, double unit) { return (float)(-std::log(1.0 - std::clamp(alpha, 0.0, 0.9999)) / unit); }
+float Extinction(double alpha, double unit)
+{
+  return (float)(-std::log(1.0 - std::clamp(alpha, 0.0, 0.9999)) / unit);
+}
 
-double UnitDistance(vtkVolumeProperty* property, int component) {
+double UnitDistance(vtkVolumeProperty* property, int component)
+{
   const double d = property->GetScalarOpacityUnitDistance(component);
-  return std::isnan(d) ? 1.0 : std::max(d, 1e-6);  // NaN: VTK's default; 0 or less: opaque (Classifier clamps)
+  return std::isnan(d) ? 1.0 : std::max(d, 1e-6); // NaN: VTK's default; 0 or less: opaque (Classifier clamps)
 }
 
 // Shade, Specular and SpecularPower on a material (the rule in the header).
-void ApplyShading(vtkVolumeProperty* property, int component, MaterialDesc& m) {
+void ApplyShading(vtkVolumeProperty* property, int component, MaterialDesc& m)
+{
   const bool shade = property->GetShade(component) != 0;
   m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
-  const double specular = property->GetSpecular(component), power = std::max(property->GetSpecularPower(component), 0.0);
+  const double specular = property->GetSpecular(component),
+               power = std::max(property->GetSpecularPower(component), 0.0);
   m.base[QuantityOffset(Quantity::Roughness)] =
-      specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
+    specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
 }
 
-bool IsConstantOne(vtkPiecewiseFunction* f) {
-  if (!f || f->GetSize() == 0) return true;
+bool IsConstantOne(vtkPiecewiseFunction* f)
+{
+  if (!f || f->GetSize() == 0)
+    return true;
   double node[4];
-  for (int i = 0; i < f->GetSize(); ++i) {
+  for (int i = 0; i < f->GetSize(); ++i)
+  {
     f->GetNodeValue(i, node);
-    if (node[1] != 1.0) return false;
+    if (node[1] != 1.0)
+      return false;
   }
   return true;
 }
 
-}  // namespace
+} // namespace
 
-bool UsesGradientOpacity(vtkVolumeProperty* property, int component) {
+bool UsesGradientOpacity(vtkVolumeProperty* property, int component)
+{
   return property && !property->GetDisableGradientOpacity(component) &&
-         !IsConstantOne(HeldGradientOpacity(property, component));
+    !IsConstantOne(HeldGradientOpacity(property, component));
 }
 
-namespace {
+namespace
+{
 
 // The property's functions with their non-finite node values read as 0 at
 // their node (a NaN x drops the node): VTK interpolates a NaN node value
 // into both neighbouring segments, which would empty them; 0 at the node
 // keeps the neighbours' ramps. Functions without such values are used as
 // they are; repaired copies live as long as this object.
-class FiniteFunctions {
- public:
-  vtkPiecewiseFunction* Of(vtkPiecewiseFunction* f) {
+class FiniteFunctions
+{
+public:
+  vtkPiecewiseFunction* Of(vtkPiecewiseFunction* f)
+  {
     return Repaired<4>(f, [](vtkPiecewiseFunction* c, const double* n) { c->AddPoint(n[0], n[1], n[2], n[3]); });
   }
-  vtkColorTransferFunction* Of(vtkColorTransferFunction* f) {
+  vtkColorTransferFunction* Of(vtkColorTransferFunction* f)
+  {
     return Repaired<6>(
-        f, [](vtkColorTransferFunction* c, const double* n) { c->AddRGBPoint(n[0], n[1], n[2], n[3], n[4], n[5]); });
+      f, [](vtkColorTransferFunction* c, const double* n) { c->AddRGBPoint(n[0], n[1], n[2], n[3], n[4], n[5]); });
   }
   // A function made here (a default), kept as long as this object.
   template <class F>
-  F* Keep(vtkSmartPointer<F> f) {
+  F* Keep(vtkSmartPointer<F> f)
+  {
     keep_.emplace_back(f);
     return f;
   }
-  int replaced = 0;  // node values read as 0, nodes dropped
+  int replaced = 0; // node values read as 0, nodes dropped
 
- private:
+private:
   // `f`, or a copy with its nodes (Count doubles each) repaired and added
   // back by `add`.
   template <int Count, class F, class Add>
-  F* Repaired(F* f, Add add) {
-    if (!f || Finite<Count>(f)) return f;
+  F* Repaired(F* f, Add add)
+  {
+    if (!f || Finite<Count>(f))
+      return f;
     vtkNew<F> copy;
     copy->DeepCopy(f);
     copy->RemoveAllPoints();
     double node[Count];
-    for (int i = 0; i < f->GetSize(); ++i) {
+    for (int i = 0; i < f->GetSize(); ++i)
+    {
       f->GetNodeValue(i, node);
-      if (Repair(node, Count)) add(copy.Get(), node);
+      if (Repair(node, Count))
+        add(copy.Get(), node);
     }
     keep_.emplace_back(copy.Get());
     return copy;
   }
   template <int Count, class F>
-  static bool Finite(F* f) {
+  static bool Finite(F* f)
+  {
     double node[Count];
-    for (int i = 0; i < f->GetSize(); ++i) {
+    for (int i = 0; i < f->GetSize(); ++i)
+    {
       f->GetNodeValue(i, node);
       for (int k = 0; k < Count; ++k)
-        if (!std::isfinite(node[k])) return false;
+        if (!std::isfinite(node[k]))
+          return false;
     }
     return true;
   }
   // Values to 0, midpoint and sharpness (the last two) to VTK's defaults;
   // false: drop the node (its position is not finite).
-  bool Repair(double* node, int count) {
-    if (!std::isfinite(node[0])) return ++replaced, false;
-    const double defaults[2] = {0.5, 0.0};
+  bool Repair(double* node, int count)
+  {
+    if (!std::isfinite(node[0]))
+      return ++replaced, false;
+    const double defaults[2] = { 0.5, 0.0 };
     for (int k = 1; k < count; ++k)
-      if (!std::isfinite(node[k])) node[k] = k >= count - 2 ? defaults[k - (count - 2)] : 0.0, ++replaced;
+      if (!std::isfinite(node[k]))
+        node[k] = k >= count - 2 ? defaults[k - (count - 2)] : 0.0, ++replaced;
     return true;
   }
   std::vector<vtkSmartPointer<vtkObject>> keep_;
@@ -146,35 +178,42 @@ class FiniteFunctions {
 
 // The functions of one material: the property's component functions, or a
 // label's (null members fall back to the component's).
-struct MaterialFunctions {
+struct MaterialFunctions
+{
   vtkPiecewiseFunction* opacity = nullptr;
-  vtkColorTransferFunction* color = nullptr;  // null with grey: `grey` instead
+  vtkColorTransferFunction* color = nullptr; // null with grey: `grey` instead
   vtkPiecewiseFunction* grey = nullptr;
-  vtkPiecewiseFunction* gradientOpacity = nullptr;  // null: not used
+  vtkPiecewiseFunction* gradientOpacity = nullptr; // null: not used
 };
 
 // Component c's own functions (its gradient opacity when it is used); VTK's
 // default where the property holds none, made here, not in the property.
-MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c, FiniteFunctions& finite) {
+MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c, FiniteFunctions& finite)
+{
   MaterialFunctions f;
   vtkPiecewiseFunction* opacity = HeldScalarOpacity(property, c);
   f.opacity = finite.Of(opacity ? opacity : finite.Keep(DefaultScalarOpacity()));
-  if (property->GetColorChannels(c) == 3) {
+  if (property->GetColorChannels(c) == 3)
+  {
     vtkColorTransferFunction* color = HeldRGBTransferFunction(property, c);
     f.color = finite.Of(color ? color : finite.Keep(DefaultRGBTransferFunction()));
-  } else {
+  }
+  else
+  {
     vtkPiecewiseFunction* grey = HeldGrayTransferFunction(property, c);
     f.grey = finite.Of(grey ? grey : finite.Keep(DefaultGrayTransferFunction()));
   }
-  if (UsesGradientOpacity(property, c)) f.gradientOpacity = finite.Of(HeldGradientOpacity(property, c));
+  if (UsesGradientOpacity(property, c))
+    f.gradientOpacity = finite.Of(HeldGradientOpacity(property, c));
   return f;
 }
 
 // `valueProxy` holds the values the functions read (the scalars, or an
 // independent component), over `valueRange`.
 MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, vtkVolumeProperty* property,
-                          int component, const ProxyLayout& proxies, Scene& scene, int valueProxy = 0,
-                          const std::array<float, 2>* valueRange = nullptr) {
+  int component, const ProxyLayout& proxies, Scene& scene, int valueProxy = 0,
+  const std::array<float, 2>* valueRange = nullptr)
+{
   MaterialDesc m;
   m.name = name;
   const std::vector<float> x = Positions(valueRange ? *valueRange : proxies.scalarRange);
@@ -190,71 +229,89 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     f.opacity->GetTable(xo.front(), xo.back(), no, alpha.data());
   else
     alpha[0] = (float)f.opacity->GetValue(xo[0]);
-  for (int i = 0; i < no; ++i) density[i] = Extinction(alpha[i], UnitDistance(property, component));
+  for (int i = 0; i < no; ++i)
+    density[i] = Extinction(alpha[i], UnitDistance(property, component));
   m.base[QuantityOffset(Quantity::Density)] = 1.f;
-  m.bindings.push_back({AddCurve(scene, name + " scalar opacity", opacityProxy, xo, density, 1), Quantity::Density});
+  m.bindings.push_back({ AddCurve(scene, name + " scalar opacity", opacityProxy, xo, density, 1), Quantity::Density });
 
   // Gradient opacity multiplies the extinction.
-  if (f.gradientOpacity && proxies.gradient >= 0) {
+  if (f.gradientOpacity && proxies.gradient >= 0)
+  {
     const std::vector<float> g = Positions(proxies.gradientRange);
     std::vector<float> gv(g.size());
-    for (size_t i = 0; i < g.size(); ++i) gv[i] = (float)std::clamp(f.gradientOpacity->GetValue(g[i]), 0.0, 1.0);
+    for (size_t i = 0; i < g.size(); ++i)
+      gv[i] = (float)std::clamp(f.gradientOpacity->GetValue(g[i]), 0.0, 1.0);
     m.bindings.push_back(
-        {AddCurve(scene, name + " gradient opacity", proxies.gradient, g, gv, 1), Quantity::Density});
+      { AddCurve(scene, name + " gradient opacity", proxies.gradient, g, gv, 1), Quantity::Density });
   }
   // A binary mask: empty where it is 0.
   if (proxies.binaryMask >= 0)
-    m.bindings.push_back({AddCurve(scene, "binary mask", proxies.binaryMask, {0.f, 1.f}, {0.f, 1.f}, 1),
-                          Quantity::Density});
+    m.bindings.push_back(
+      { AddCurve(scene, "binary mask", proxies.binaryMask, { 0.f, 1.f }, { 0.f, 1.f }, 1), Quantity::Density });
 
   // Albedo: the RGB components themselves (4 dependent components), one
   // channel per proxy, multiplied.
-  if (proxies.rgb[0] >= 0) {
-    for (int c = 0; c < 3; ++c) {
-      std::vector<float> values = {1.f, 1.f, 1.f, 1.f, 1.f, 1.f};
+  if (proxies.rgb[0] >= 0)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      std::vector<float> values = { 1.f, 1.f, 1.f, 1.f, 1.f, 1.f };
       values[c] = 0.f;
       values[3 + c] = 1.f;
-      m.bindings.push_back({AddCurve(scene, name + " rgb", proxies.rgb[c], {0.f, proxies.colorScale}, values, 3),
-                            Quantity::Albedo});
+      m.bindings.push_back(
+        { AddCurve(scene, name + " rgb", proxies.rgb[c], { 0.f, proxies.colorScale }, values, 3), Quantity::Albedo });
     }
-  } else {
+  }
+  else
+  {
     // Albedo from colour.
     std::vector<float> rgb(3 * n);
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < n; ++i)
+    {
       double c[3];
-      if (f.color) {
+      if (f.color)
+      {
         f.color->GetColor(x[i], c);
-      } else {
+      }
+      else
+      {
         c[0] = c[1] = c[2] = f.grey->GetValue(x[i]);
       }
-      for (int k = 0; k < 3; ++k) rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
+      for (int k = 0; k < 3; ++k)
+        rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
     }
-    m.bindings.push_back({AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo});
+    m.bindings.push_back({ AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo });
   }
   ApplyShading(property, component, m);
   return m;
 }
 
-}  // namespace
+} // namespace
 
 // The property's 2D transfer function, when it is the one in use.
-vtkImageData* TransferFunction2D(vtkVolumeProperty* property, int component) {
-  if (property->GetTransferFunctionMode() != vtkVolumeProperty::TF_2D) return nullptr;
+vtkImageData* TransferFunction2D(vtkVolumeProperty* property, int component)
+{
+  if (property->GetTransferFunctionMode() != vtkVolumeProperty::TF_2D)
+    return nullptr;
   vtkImageData* f = property->GetTransferFunction2D(component);
   if (!f || !f->GetPointData()->GetScalars() || f->GetPointData()->GetScalars()->GetNumberOfComponents() != 4)
     return nullptr;
   return f;
 }
 
-bool NeedsGradientProxy(vtkVolumeProperty* property, int component, bool labels) {
-  if (UsesGradientOpacity(property, component) || TransferFunction2D(property, component)) return true;
+bool NeedsGradientProxy(vtkVolumeProperty* property, int component, bool labels)
+{
+  if (UsesGradientOpacity(property, component) || TransferFunction2D(property, component))
+    return true;
   if (labels)
     for (int label : property->GetLabelMapLabels())
-      if (!IsConstantOne(property->GetLabelGradientOpacity(label))) return true;
+      if (!IsConstantOne(property->GetLabelGradientOpacity(label)))
+        return true;
   return false;
 }
 
-namespace {
+namespace
+{
 
 // A 2D transfer function (x: scalar value, y: gradient magnitude, RGBA) as
 // materials: the scalar axis is cut into at most kMax2DBands bands, each a
@@ -265,8 +322,9 @@ namespace {
 // columns), where VTK interpolates between columns.
 constexpr int kMax2DBands = 64;
 
-void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
-                    Scene& scene) {
+void Add2DMaterials(
+  vtkImageData* table, vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
+{
   int dims[3];
   table->GetDimensions(dims);
   double origin[3], spacing[3];
@@ -276,23 +334,29 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
   const int nx = dims[0], ny = dims[1];
   const int bands = std::min(nx, kMax2DBands);
   std::vector<float> g(ny);
-  for (int j = 0; j < ny; ++j) g[j] = (float)(origin[1] + j * spacing[1]);
-  if (ny == 1) g.push_back(g[0] + 1.f);  // a constant in the gradient: two equal points
+  for (int j = 0; j < ny; ++j)
+    g[j] = (float)(origin[1] + j * spacing[1]);
+  if (ny == 1)
+    g.push_back(g[0] + 1.f); // a constant in the gradient: two equal points
   TransferFunctionDesc selector;
   selector.where = "2D transfer function";
   selector.type = TFType::MPCTF;
   selector.proxy = 0;
   selector.channels = 1;
-  for (int b = 0; b < bands; ++b) {
-    const int i0 = b * nx / bands, i1 = (b + 1) * nx / bands;  // columns [i0, i1)
+  for (int b = 0; b < bands; ++b)
+  {
+    const int i0 = b * nx / bands, i1 = (b + 1) * nx / bands; // columns [i0, i1)
     std::vector<float> density, albedo;
-    for (int j = 0; j < (int)g.size(); ++j) {
+    for (int j = 0; j < (int)g.size(); ++j)
+    {
       const int row = std::min(j, ny - 1);
-      double sum[4] = {0, 0, 0, 0};
+      double sum[4] = { 0, 0, 0, 0 };
       for (int i = i0; i < i1; ++i)
-        for (int c = 0; c < 4; ++c) sum[c] += rgba->GetComponent(i + (vtkIdType)nx * row, c) / (i1 - i0);
+        for (int c = 0; c < 4; ++c)
+          sum[c] += rgba->GetComponent(i + (vtkIdType)nx * row, c) / (i1 - i0);
       density.push_back(Extinction(sum[3], UnitDistance(property, component)));
-      for (int c = 0; c < 3; ++c) albedo.push_back((float)std::clamp(sum[c], 0.0, 1.0));
+      for (int c = 0; c < 3; ++c)
+        albedo.push_back((float)std::clamp(sum[c], 0.0, 1.0));
     }
     // The band covers its columns' cells: from half a column below the
     // first to half a column above the last (the outer bands extend far).
@@ -301,8 +365,8 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
     MaterialDesc m;
     m.name = "2D band " + std::to_string(b);
     m.base[QuantityOffset(Quantity::Density)] = 1.f;
-    m.bindings.push_back({AddCurve(scene, m.name + " opacity", proxies.gradient, g, density, 1), Quantity::Density});
-    m.bindings.push_back({AddCurve(scene, m.name + " color", proxies.gradient, g, albedo, 3), Quantity::Albedo});
+    m.bindings.push_back({ AddCurve(scene, m.name + " opacity", proxies.gradient, g, density, 1), Quantity::Density });
+    m.bindings.push_back({ AddCurve(scene, m.name + " color", proxies.gradient, g, albedo, 3), Quantity::Albedo });
     ApplyShading(property, component, m);
     selector.keys.push_back((float)lo);
     selector.keys.push_back((float)hi);
@@ -313,26 +377,30 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
   scene.selectors.push_back((int)scene.tfs.size() - 1);
 }
 
-}  // namespace
+} // namespace
 
-namespace {
+namespace
+{
 
 // Returns how many function node values were not finite.
-int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
+{
   FiniteFunctions finite;
   scene.tfs.clear();
   scene.materials.clear();
   scene.selectors.clear();
   scene.additiveMaterials = false;
-  if (proxies.independent > 1) {
+  if (proxies.independent > 1)
+  {
     // A material per component, mixed additively; each reads its own proxy.
-    for (int c = 0; c < proxies.independent; ++c) {
+    for (int c = 0; c < proxies.independent; ++c)
+    {
       MaterialFunctions f = ComponentFunctions(property, c, finite);
-      ProxyLayout own = proxies;  // this component's gradient proxy, if there was room for one
+      ProxyLayout own = proxies; // this component's gradient proxy, if there was room for one
       own.gradient = proxies.componentGradient[c];
       own.gradientRange = proxies.componentGradientRanges[c];
-      MaterialDesc m = MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c,
-                                    &proxies.componentRanges[c]);
+      MaterialDesc m =
+        MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c, &proxies.componentRanges[c]);
       m.base[QuantityOffset(Quantity::Density)] = (float)std::max(property->GetComponentWeight(c), 0.0);
       scene.materials.push_back(std::move(m));
     }
@@ -341,78 +409,99 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
     return finite.replaced;
   }
   const MaterialFunctions main = ComponentFunctions(property, component, finite);
-  if (vtkImageData* table = TransferFunction2D(property, component); table && proxies.gradient >= 0) {
-    Add2DMaterials(table, property, component, proxies, scene);  // no default: outside the bands is empty
+  if (vtkImageData* table = TransferFunction2D(property, component); table && proxies.gradient >= 0)
+  {
+    Add2DMaterials(table, property, component, proxies, scene); // no default: outside the bands is empty
     scene.defaultMaterial = kNoMaterial;
-  } else {
+  }
+  else
+  {
     scene.materials.push_back(MakeMaterial("volume", main, property, component, proxies, scene));
     scene.defaultMaterial = 0;
   }
 
   // Labels: a material each, picked by an MDPTF over the label map.
-  if (proxies.labels < 0) return finite.replaced;
+  if (proxies.labels < 0)
+    return finite.replaced;
   TransferFunctionDesc selector;
   selector.where = "label map";
   selector.type = TFType::MDPTF;
   selector.proxy = proxies.labels;
   selector.channels = 1;
-  for (int label : property->GetLabelMapLabels()) {
-    if (label == 0) continue;  // 0 is unlabelled: the component's functions
+  for (int label : property->GetLabelMapLabels())
+  {
+    if (label == 0)
+      continue; // 0 is unlabelled: the component's functions
     MaterialFunctions f = main;
-    if (vtkPiecewiseFunction* o = property->GetLabelScalarOpacity(label)) f.opacity = finite.Of(o);
-    if (vtkColorTransferFunction* c = property->GetLabelColor(label)) f.color = finite.Of(c), f.grey = nullptr;
+    if (vtkPiecewiseFunction* o = property->GetLabelScalarOpacity(label))
+      f.opacity = finite.Of(o);
+    if (vtkColorTransferFunction* c = property->GetLabelColor(label))
+      f.color = finite.Of(c), f.grey = nullptr;
     if (vtkPiecewiseFunction* g = property->GetLabelGradientOpacity(label))
       f.gradientOpacity = IsConstantOne(g) ? nullptr : finite.Of(g);
     selector.keys.push_back((float)label);
     selector.materials.push_back((int)scene.materials.size());
     scene.materials.push_back(MakeMaterial("label " + std::to_string(label), f, property, component, proxies, scene));
   }
-  if (selector.keys.empty()) return finite.replaced;
+  if (selector.keys.empty())
+    return finite.replaced;
   scene.tfs.push_back(std::move(selector));
-  scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1);  // labels first
+  scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1); // labels first
   return finite.replaced;
 }
 
 // NaN in (clamped or not) reaches the TF values and material bases; 0 in
 // their place (no extinction, black), counted.
-int ReplaceNonFinite(Scene& scene) {
+int ReplaceNonFinite(Scene& scene)
+{
   int replaced = 0;
-  auto fix = [&](float& v) {
-    if (!std::isfinite(v)) v = 0.f, ++replaced;
+  auto fix = [&](float& v)
+  {
+    if (!std::isfinite(v))
+      v = 0.f, ++replaced;
   };
   for (TransferFunctionDesc& tf : scene.tfs)
-    for (float& v : tf.values) fix(v);
+    for (float& v : tf.values)
+      fix(v);
   for (MaterialDesc& m : scene.materials)
-    for (float& v : m.base) fix(v);
+    for (float& v : m.base)
+      fix(v);
   return replaced;
 }
 
-}  // namespace
+} // namespace
 
-int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene) {
+int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
+{
   const int nodes = TranslateMaterials(property, component, proxies, scene);
   return nodes + ReplaceNonFinite(scene);
 }
 
 void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
-                  const ProxyLayout& proxies, Scene& scene) {
-  if (proxies.labels < 0) return;
+  const ProxyLayout& proxies, Scene& scene)
+{
+  if (proxies.labels < 0)
+    return;
   const nlohmann::json rule = LabelMaterial(look);
   MaterialDesc m;
   m.name = "label " + std::to_string(label);
   m.base[QuantityOffset(Quantity::Density)] = rule["density"].get<float>();
-  for (int c = 0; c < 3; ++c) m.base[QuantityOffset(Quantity::Albedo) + c] = rule["albedo"][c].get<float>();
+  for (int c = 0; c < 3; ++c)
+    m.base[QuantityOffset(Quantity::Albedo) + c] = rule["albedo"][c].get<float>();
   ApplyShading(property, component, m);
-  if (const int index = scene.MaterialIndex(m.name); index >= 0) {
-    scene.materials[index] = std::move(m);  // the property's label functions made it: the selector has it
+  if (const int index = scene.MaterialIndex(m.name); index >= 0)
+  {
+    scene.materials[index] = std::move(m); // the property's label functions made it: the selector has it
     return;
   }
   // The label selector (SetMaterialsFromProperty puts it first), made when
   // the property has no label functions.
   TransferFunctionDesc* selector = nullptr;
   for (int i : scene.selectors)
-    if (scene.tfs[i].where == "label map") selector = &scene.tfs[i];
-  if (!selector) {
+    if (scene.tfs[i].where == "label map")
+      selector = &scene.tfs[i];
+  if (!selector)
+  {
     TransferFunctionDesc tf;
     tf.where = "label map";
     tf.type = TFType::MDPTF;
@@ -429,74 +518,99 @@ void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property,
   scene.materials.push_back(std::move(m));
 }
 
-void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene) {
+void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene)
+{
   const std::string where = "label " + std::to_string(label) + " material";
   const nlohmann::json doc = ParseJson(json, where);
-  if (!doc.is_object()) throw InputError(where + ": expected a JSON object");
+  if (!doc.is_object())
+    throw InputError(where + ": expected a JSON object");
   const int index = scene.MaterialIndex("label " + std::to_string(label));
-  if (index < 0) return;
+  if (index < 0)
+    return;
   MaterialDesc& m = scene.materials[index];
-  auto number = [&](const std::string& key, const nlohmann::json& v, float lo, float hi) {
+  auto number = [&](const std::string& key, const nlohmann::json& v, float lo, float hi)
+  {
     if (!v.is_number() || !(v.get<double>() >= lo && v.get<double>() <= hi))
-      throw InputError(where + "." + key + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      throw InputError(
+        where + "." + key + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v.get<float>();
   };
-  for (const auto& [key, value] : doc.items()) {
-    if (key == "roughness") m.base[QuantityOffset(Quantity::Roughness)] = number(key, value, 0.f, 1.f);
-    else if (key == "metallic") m.base[QuantityOffset(Quantity::Metallic)] = number(key, value, 0.f, 1.f);
-    else if (key == "surface_probability") m.base[QuantityOffset(Quantity::SurfaceProbability)] = number(key, value, 0.f, 1.f);
-    else if (key == "anisotropy") m.base[QuantityOffset(Quantity::Anisotropy)] = number(key, value, -0.99f, 0.99f);
-    else if (key == "emission") {
-      if (!value.is_array() || value.size() != 3) throw InputError(where + ".emission: expected [r, g, b]");
-      for (int c = 0; c < 3; ++c) m.base[QuantityOffset(Quantity::Emission) + c] = number(key, value[c], 0.f, 1e6f);
-    } else
-      throw InputError(where + ": unknown key '" + key +
-                       "' (roughness, metallic, surface_probability, anisotropy, emission)");
+  for (const auto& [key, value] : doc.items())
+  {
+    if (key == "roughness")
+      m.base[QuantityOffset(Quantity::Roughness)] = number(key, value, 0.f, 1.f);
+    else if (key == "metallic")
+      m.base[QuantityOffset(Quantity::Metallic)] = number(key, value, 0.f, 1.f);
+    else if (key == "surface_probability")
+      m.base[QuantityOffset(Quantity::SurfaceProbability)] = number(key, value, 0.f, 1.f);
+    else if (key == "anisotropy")
+      m.base[QuantityOffset(Quantity::Anisotropy)] = number(key, value, -0.99f, 0.99f);
+    else if (key == "emission")
+    {
+      if (!value.is_array() || value.size() != 3)
+        throw InputError(where + ".emission: expected [r, g, b]");
+      for (int c = 0; c < 3; ++c)
+        m.base[QuantityOffset(Quantity::Emission) + c] = number(key, value[c], 0.f, 1e6f);
+    }
+    else
+      throw InputError(
+        where + ": unknown key '" + key + "' (roughness, metallic, surface_probability, anisotropy, emission)");
   }
 }
 
-void SetCameraFromVtk(vtkCamera* camera, Scene& scene) {
+void SetCameraFromVtk(vtkCamera* camera, Scene& scene)
+{
   CameraDesc& c = scene.camera;
   c.autoFrame = false;
   const double* p = camera->GetPosition();
   const double* f = camera->GetFocalPoint();
   const double* u = camera->GetViewUp();
-  c.position = {(float)p[0], (float)p[1], (float)p[2]};
-  c.lookAt = {(float)f[0], (float)f[1], (float)f[2]};
-  c.up = {(float)u[0], (float)u[1], (float)u[2]};
+  c.position = { (float)p[0], (float)p[1], (float)p[2] };
+  c.lookAt = { (float)f[0], (float)f[1], (float)f[2] };
+  c.up = { (float)u[0], (float)u[1], (float)u[2] };
   c.lensRadius = 0.f;
-  if (camera->GetParallelProjection()) {
+  if (camera->GetParallelProjection())
+  {
     c.projection = Projection::Orthographic;
     c.orthoHeight = (float)(2.0 * camera->GetParallelScale());
-  } else {
+  }
+  else
+  {
     c.projection = Projection::Perspective;
     c.fovY = (float)camera->GetViewAngle();
   }
 }
 
-void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene& scene) {
+void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene& scene)
+{
   scene.lights.clear();
   scene.cameraLights.clear();
   vtkLightCollection* lights = renderer->GetLights();
   lights->InitTraversal();
-  while (vtkLight* light = lights->GetNextItem()) {
-    if (!light->GetSwitch() || light->GetIntensity() <= 0.0) continue;
+  while (vtkLight* light = lights->GetNextItem())
+  {
+    if (!light->GetSwitch() || light->GetIntensity() <= 0.0)
+      continue;
     double p[3], f[3];
     light->GetTransformedPosition(p);
     light->GetTransformedFocalPoint(f);
-    const Vec3 position{(float)p[0], (float)p[1], (float)p[2]}, focal{(float)f[0], (float)f[1], (float)f[2]};
+    const Vec3 position{ (float)p[0], (float)p[1], (float)p[2] }, focal{ (float)f[0], (float)f[1], (float)f[2] };
     const Vec3 toLight = position - focal;
     const float distance = Length(toLight);
-    if (!(distance > 0.f)) continue;
+    if (!(distance > 0.f))
+      continue;
     const double* col = light->GetDiffuseColor();
     const float scale = kPi * (float)light->GetIntensity();
     Light l;
     l.L = RGB((float)col[0] * scale, (float)col[1] * scale, (float)col[2] * scale);
-    if (light->GetPositional()) {
+    if (light->GetPositional())
+    {
       l.type = LightType::Point;
       l.vector = position;
-      l.L = l.L * (distance * distance);  // irradiance pi * intensity at the focal point
-    } else {
+      l.L = l.L * (distance * distance); // irradiance pi * intensity at the focal point
+    }
+    else
+    {
       l.type = LightType::Directional;
       l.vector = toLight / distance;
     }
@@ -506,4 +620,4 @@ void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene&
   scene.environment = ambient > 0.f ? EnvironmentMap::Constant(RGB(ambient, ambient, ambient)) : nullptr;
 }
 
-}  // namespace mmrtm
+} // namespace mmrtm

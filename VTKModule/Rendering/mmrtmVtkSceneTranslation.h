@@ -43,7 +43,8 @@ class vtkCamera;
 class vtkRenderer;
 class vtkVolumeProperty;
 
-namespace mmrtm {
+namespace mmrtm
+{
 
 constexpr int kTableSize = 256;
 constexpr float kShadedSurfaceProbability = 0.8f;
@@ -55,19 +56,20 @@ bool UsesGradientOpacity(vtkVolumeProperty* property, int component);
 bool NeedsGradientProxy(vtkVolumeProperty* property, int component, bool labels);
 
 // Which proxies the translation may read (index in Scene::proxies, or -1).
-struct ProxyLayout {
-  std::array<float, 2> scalarRange{0.f, 0.f};
-  int gradient = -1;  // gradient magnitude of the scalars
-  std::array<float, 2> gradientRange{0.f, 0.f};
-  int labels = -1;       // a label map (the mapper's mask, LABELMAP)
-  int binaryMask = -1;   // a binary mask (BINARY)
+struct ProxyLayout
+{
+  std::array<float, 2> scalarRange{ 0.f, 0.f };
+  int gradient = -1; // gradient magnitude of the scalars
+  std::array<float, 2> gradientRange{ 0.f, 0.f };
+  int labels = -1;     // a label map (the mapper's mask, LABELMAP)
+  int binaryMask = -1; // a binary mask (BINARY)
   // IndependentComponents off: with 2 components, proxy 0 is coloured by
   // the colour function and `opacity` (component 1) gives the opacity; with
   // 4, `rgb` are the colour components (divided by colorScale) and `opacity`
   // (component 3) goes through the scalar-opacity function.
   int opacity = -1;
-  std::array<float, 2> opacityRange{0.f, 0.f};
-  int rgb[3] = {-1, -1, -1};
+  std::array<float, 2> opacityRange{ 0.f, 0.f };
+  int rgb[3] = { -1, -1, -1 };
   float colorScale = 255.f;
   // IndependentComponents on with several components: proxy c is
   // component c (c < independent), each with its own functions, mixed
@@ -76,7 +78,7 @@ struct ProxyLayout {
   std::array<std::array<float, 2>, 4> componentRanges{};
   // The gradient magnitude of an independent component whose gradient
   // opacity is used (-1: none), while there is room among the 4 proxies.
-  std::array<int, 4> componentGradient{-1, -1, -1, -1};
+  std::array<int, 4> componentGradient{ -1, -1, -1, -1 };
   std::array<std::array<float, 2>, 4> componentGradientRanges{};
 };
 
@@ -98,7 +100,7 @@ int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const P
 // the property's label functions made, else added to the label selector.
 // Throws InputError for a look out of range.
 void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
-                  const ProxyLayout& proxies, Scene& scene);
+  const ProxyLayout& proxies, Scene& scene);
 
 // Gives label `label`'s material (made by SetMaterialsFromProperty) the
 // surface and phase parameters VTK's label functions cannot say: a JSON
@@ -116,4 +118,4 @@ void SetCameraFromVtk(vtkCamera* camera, Scene& scene);
 // the environment with the property's ambient term.
 void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene& scene);
 
-}  // namespace mmrtm
+} // namespace mmrtm

@@ -86,7 +86,7 @@ bool ChangeDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, Ch
     vtkErrorWithObjectMacro(self, << e.what());
     return false;
   }
-  if (next == document)  // as vtkSetMacro: an unchanged value leaves the modification time
+  if (next == document) // as vtkSetMacro: an unchanged value leaves the modification time
     return true;
   document = std::move(next);
   self->Modified();
@@ -101,9 +101,9 @@ nlohmann::json ParseJson(const char* text)
 
 bool vtkMultiMaterialProperty::SetPreset(const char* name)
 {
-  return ChangeDocument(this, this->Internal->Document, [name](nlohmann::json& doc) {
-    doc = mmrtm::ReadJsonFile(mmrtm::PresetPath(GetPresetDirectory(), name ? name : ""));
-  });
+  return ChangeDocument(this, this->Internal->Document,
+    [name](nlohmann::json& doc)
+    { doc = mmrtm::ReadJsonFile(mmrtm::PresetPath(GetPresetDirectory(), name ? name : "")); });
 }
 
 bool vtkMultiMaterialProperty::SetSceneFile(const char* path)

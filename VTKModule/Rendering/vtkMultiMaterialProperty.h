@@ -27,11 +27,11 @@
 #ifndef vtkMultiMaterialProperty_h
 #define vtkMultiMaterialProperty_h
 
-#include "mmrtmRenderingModule.h"  // for export macro
+#include "mmrtmRenderingModule.h" // for export macro
 #include "vtkObject.h"
 
-#include <memory>  // for std::unique_ptr
-#include <string>  // for std::string
+#include <memory> // for std::unique_ptr
+#include <string> // for std::string
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialProperty : public vtkObject
 {

@@ -61,22 +61,21 @@ struct vtkMultiMaterialVolumeMapper::InputState
   {
     vtkImageData* Data = nullptr;
     vtkMTimeType DataTime = 0;
-    vtkDataArray* Scalars = nullptr;  // the array the mapper's scalar mode picks
+    vtkDataArray* Scalars = nullptr; // the array the mapper's scalar mode picks
     vtkImageData* Mask = nullptr;
     vtkMTimeType MaskTime = 0;
     int MaskType = -1;
     vtkMultiMaterialProperty* MultiMaterial = nullptr;
-    int Dependent = -1;    // components used as colour + opacity (IndependentComponents off)
-    int Independent = -1;  // components mixed additively (IndependentComponents on)
-    int ComponentGradients = -1;  // independent components with gradient opacity (bit c)
-    bool NeedGradient = false;    // a gradient-magnitude proxy (without a description)
+    int Dependent = -1;          // components used as colour + opacity (IndependentComponents off)
+    int Independent = -1;        // components mixed additively (IndependentComponents on)
+    int ComponentGradients = -1; // independent components with gradient opacity (bit c)
+    bool NeedGradient = false;   // a gradient-magnitude proxy (without a description)
     bool operator==(const ProxyInputs& o) const
     {
       return std::tie(this->Data, this->DataTime, this->Scalars, this->Mask, this->MaskTime, this->MaskType,
-               this->MultiMaterial, this->Dependent, this->Independent, this->ComponentGradients,
-               this->NeedGradient) == std::tie(o.Data, o.DataTime, o.Scalars, o.Mask, o.MaskTime, o.MaskType,
-                                       o.MultiMaterial, o.Dependent, o.Independent, o.ComponentGradients,
-                                       o.NeedGradient);
+               this->MultiMaterial, this->Dependent, this->Independent, this->ComponentGradients, this->NeedGradient) ==
+        std::tie(o.Data, o.DataTime, o.Scalars, o.Mask, o.MaskTime, o.MaskType, o.MultiMaterial, o.Dependent,
+          o.Independent, o.ComponentGradients, o.NeedGradient);
     }
   } Proxies;
 
@@ -89,9 +88,9 @@ struct vtkMultiMaterialVolumeMapper::InputState
   struct ViewInputs
   {
     int Width = 0, Height = 0;  // the viewport's
-    std::vector<double> Values;  // camera, lights, matrix, size, clipping, environment: SameView
+    std::vector<double> Values; // camera, lights, matrix, size, clipping, environment: SameView
     std::vector<mmrtm::ClipPlane> Clip;
-    std::vector<float> Depth;  // the depth buffer under the volume
+    std::vector<float> Depth; // the depth buffer under the volume
     vtkMTimeType TracingTime = 0;
   } View;
 };
@@ -99,10 +98,10 @@ struct vtkMultiMaterialVolumeMapper::InputState
 // Which phases a render must run: the answer of ChangesSince.
 struct vtkMultiMaterialVolumeMapper::Changes
 {
-  bool Proxies = false;      // made again from the input (and the description parsed over them)
-  bool Description = false;  // the description parsed again over the proxies as they are
-  bool Materials = false;    // the property translated again
-  bool View = false;         // the camera, lights and settings set again
+  bool Proxies = false;     // made again from the input (and the description parsed over them)
+  bool Description = false; // the description parsed again over the proxies as they are
+  bool Materials = false;   // the property translated again
+  bool View = false;        // the camera, lights and settings set again
   bool Any() const { return this->Proxies || this->Description || this->Materials || this->View; }
 };
 
@@ -114,7 +113,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   int RendererBackend = -1, RendererThreads = -1;
   std::unique_ptr<mmrtm::Film> Film;
   std::string BackendDescription;
-  vtkNew<vtkMatrix4x4> Matrix;  // the volume's matrix at the last render
+  vtkNew<vtkMatrix4x4> Matrix; // the volume's matrix at the last render
   // Draws the image as a texture: the OpenGL helper, from the object factory
   // at the first draw (RenderingVolumeOpenGL2 must be loaded by then).
   vtkSmartPointer<vtkRayCastImageDisplayHelper> DisplayHelper;
@@ -124,9 +123,9 @@ struct vtkMultiMaterialVolumeMapper::Internals
   mmrtm::ProxyLayout Layout;
   vtkSmartPointer<vtkImageData> Mask;
   vtkSmartPointer<vtkMultiMaterialProperty> MultiMaterial;
-  bool LightsFromScene = false;  // the multi-material description has its own lights
+  bool LightsFromScene = false; // the multi-material description has its own lights
   vtkSmartPointer<vtkTexture> EnvironmentTexture;
-  std::shared_ptr<mmrtm::EnvironmentMap> Environment;  // converted from the texture
+  std::shared_ptr<mmrtm::EnvironmentMap> Environment; // converted from the texture
   vtkMTimeType EnvironmentTime = 0;
   double EnvironmentScale = 0;
   // SetLabelMaterial and SetLabelMaterialParameters, by label, and when
@@ -142,7 +141,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   // The inputs as the scene and the film were last made from them; each
   // render compares what it finds with these (ChangesSince).
   InputState Built;
-  bool HasScene = false;  // false until a build succeeds, and after a failed one
+  bool HasScene = false; // false until a build succeeds, and after a failed one
 
   // Whether each warning's cause held when it was last checked: a warning
   // is said when its cause appears, and again only after the cause went
@@ -182,7 +181,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
     this->GridBuilds += this->Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
     this->GridRefits += this->Scene.GridRefittedByLastBuild() ? 1 : 0;
   }
-  std::string LastExtinctionWarning;  // said once per change (vtkWarningMacro)
+  std::string LastExtinctionWarning; // said once per change (vtkWarningMacro)
   double LastBuildSeconds = 0;
   // While the interactor moves the camera: a preview at 1/PreviewFactor of
   // the resolution, 1 sample per pixel, the factor adapted to the frame rate.
@@ -214,8 +213,8 @@ vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
   vtkMTimeType t = missColours ? MTimeWithoutColours(p) : p->GetMTime();
   if (vtkImageData* table = p->GetTransferFunction2D(0))
     t = std::max(t, table->GetMTime());
-  for (const vtkTimeStamp& set : { p->GetLabelColorMTime(), p->GetLabelScalarOpacityMTime(),
-         p->GetLabelGradientOpacityMTime() })
+  for (const vtkTimeStamp& set :
+    { p->GetLabelColorMTime(), p->GetLabelScalarOpacityMTime(), p->GetLabelGradientOpacityMTime() })
     t = std::max(t, set.GetMTime());
   for (int label : p->GetLabelMapLabels())
   {
@@ -319,8 +318,7 @@ std::vector<float> CameraRayMaxDistance(vtkRenderer* ren, const std::vector<floa
         len2 += d[k] * d[k];
         along += d[k] * dir[k];
       }
-      t[static_cast<size_t>(height - 1 - row) * width + x] =
-        static_cast<float>(parallel ? along : std::sqrt(len2));
+      t[static_cast<size_t>(height - 1 - row) * width + x] = static_cast<float>(parallel ? along : std::sqrt(len2));
     }
   return t;
 }
@@ -358,7 +356,7 @@ void vtkMultiMaterialVolumeMapper::FinishPass(bool cancel)
   if (in.InFlight->Completed)
     in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
   else
-    in.Film.reset();  // a partial pass: the next render restarts
+    in.Film.reset(); // a partial pass: the next render restarts
   in.InFlight.reset();
 }
 
@@ -415,7 +413,7 @@ void vtkMultiMaterialVolumeMapper::SetMultiMaterialProperty(vtkMultiMaterialProp
 {
   if (this->Internal->MultiMaterial != property)
   {
-    this->Internal->MultiMaterial = property;  // another source of materials: the proxies are made again
+    this->Internal->MultiMaterial = property; // another source of materials: the proxies are made again
     this->Modified();
   }
 }
@@ -555,7 +553,7 @@ void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
   values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
   for (int y = 0; y < height; ++y)
   {
-    const int row = height - 1 - y;  // the film's row 0 is the top, VTK's the bottom
+    const int row = height - 1 - y; // the film's row 0 is the top, VTK's the bottom
     for (int x = 0; x < width; ++x)
     {
       const mmrtm::RGB c = film->Mean(x, y);
@@ -618,7 +616,7 @@ const char* vtkMultiMaterialVolumeMapper::GetBackendDescription()
 void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   Internals& in = *this->Internal;
-  int viewport[4] = { 0, 0, 0, 0 };  // width, height, origin x, origin y
+  int viewport[4] = { 0, 0, 0, 0 }; // width, height, origin x, origin y
   if (!this->ValidateInputs(ren, vol, viewport))
     return;
   try
@@ -638,7 +636,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
           this->DrawFilm(ren, vol, *in.Shown);
         return;
       }
-      this->FinishPass(!in.InFlight->Done);  // a stopped pass leaves no film: a restart
+      this->FinishPass(!in.InFlight->Done); // a stopped pass leaves no film: a restart
     }
 
     if (changes.Proxies)
@@ -752,8 +750,7 @@ vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince
   const bool description = now.Proxies.MultiMaterial != nullptr;
   c.Description = description && now.Materials.MultiMaterialTime != built.Materials.MultiMaterialTime;
   c.Materials = !description &&
-    (now.Materials.Property != built.Materials.Property ||
-      now.Materials.PropertyTime != built.Materials.PropertyTime ||
+    (now.Materials.Property != built.Materials.Property || now.Materials.PropertyTime != built.Materials.PropertyTime ||
       now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime);
   c.View = !SameView(now.View.Values, built.View.Values) || now.View.Depth != built.View.Depth ||
     now.View.TracingTime != built.View.TracingTime;
@@ -763,7 +760,7 @@ vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince
 void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
 {
   Internals& in = *this->Internal;
-  in.HasScene = false;  // until the rebuild succeeds
+  in.HasScene = false; // until the rebuild succeeds
   const bool labels = now.Proxies.Mask && now.Proxies.MaskType == LABELMAP;
   const InputState::ProxyInputs& p = now.Proxies;
   this->BuildProxies(now.Materials.Property, p.Data, p.Scalars, p.Dependent, p.Independent, p.NeedGradient, labels);
@@ -774,7 +771,7 @@ void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
     in.ImageIndexToWorld.push_back(v.indexToWorld);
   in.Scene.MarkDataModified();
   in.Built.Proxies = now.Proxies;
-  in.Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime;  // parsed over them
+  in.Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime; // parsed over them
   ++in.SceneBuilds;
 }
 
@@ -832,12 +829,11 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
   rs.integrator.seed = static_cast<uint64_t>(this->Seed);
   rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
   rs.integrator.maxBounces = this->MaximumBounces;
-  rs.integrator.sampler =
-    this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
+  rs.integrator.sampler = this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
   rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
-    : this->Accelerator == NO_ACCELERATOR             ? mmrtm::MajorantKind::Global
-                                                      : mmrtm::MajorantKind::Octree;
-  rs.integrator.backgroundVisible = false;  // VTK's background shows through
+    : this->Accelerator == NO_ACCELERATOR              ? mmrtm::MajorantKind::Global
+                                                       : mmrtm::MajorantKind::Octree;
+  rs.integrator.backgroundVisible = false; // VTK's background shows through
   in.Film = std::make_unique<mmrtm::Film>(width, height);
   in.Built.View = std::move(now.View);
   in.HasScene = true;
@@ -852,8 +848,8 @@ void vtkMultiMaterialVolumeMapper::UpdateRenderer()
   const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
     : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
                                                       : mmrtm::Backend::Auto;
-  in.Renderer = mmrtm::MakeRenderer(
-    backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); });
+  in.Renderer =
+    mmrtm::MakeRenderer(backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); });
   in.RendererBackend = this->Backend;
   in.RendererThreads = this->NumberOfThreads;
   in.BackendDescription = in.Renderer->Description();
@@ -867,7 +863,7 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   const auto buildStart = std::chrono::steady_clock::now();
   const mmrtm::SceneView sceneView = in.Scene.Build();
   in.CountGridWork();
-  if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning)  // once per change, not per render
+  if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning) // once per change, not per render
   {
     in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
     if (!in.LastExtinctionWarning.empty())
@@ -888,17 +884,19 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     mmrtm::Renderer* renderer = in.Renderer.get();
     mmrtm::Film* film = in.Film.get();
     const mmrtm::Scene* scene = &in.Scene;
-    p->Thread = std::thread([p, renderer, film, scene, sceneView, samples] {
-      try
+    p->Thread = std::thread(
+      [p, renderer, film, scene, sceneView, samples]
       {
-        p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
-      }
-      catch (const std::exception& e)
-      {
-        p->Error = e.what();
-      }
-      p->Done = true;
-    });
+        try
+        {
+          p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
+        }
+        catch (const std::exception& e)
+        {
+          p->Error = e.what();
+        }
+        p->Done = true;
+      });
     in.InFlight = std::move(pass);
     return in.Shown.get();
   }
@@ -911,8 +909,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
 
 // The proxies of the input (its components as the property uses them), the
 // gradient magnitude when some function reads it, and the mask.
-void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtkImageData* input,
-  vtkDataArray* scalars, int dependent, int independent, bool needGradient, bool labels)
+void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars,
+  int dependent, int independent, bool needGradient, bool labels)
 {
   Internals& in = *this->Internal;
   vtkImageData* mask = independent ? nullptr : in.Mask.Get();
@@ -920,9 +918,9 @@ void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtk
   scene.proxies.clear();
   in.ImageIndexToWorld.clear();
   in.Layout = mmrtm::ProxyLayout();
-  auto component = [&](int c, const char* name) {
-    scene.proxies.push_back(
-      mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
+  auto component = [&](int c, const char* name)
+  {
+    scene.proxies.push_back(mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
     return static_cast<int>(scene.proxies.size()) - 1;
   };
   component(0, dependent == 4 ? "red" : "scalars");
@@ -968,7 +966,7 @@ void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtk
   if (in.Layout.opacity >= 0)
   {
     in.Layout.opacityRange = scene.proxies[in.Layout.opacity].ValueRange();
-    scene.gradientProxy = in.Layout.opacity;  // VTK shades dependent data by the opacity component
+    scene.gradientProxy = in.Layout.opacity; // VTK shades dependent data by the opacity component
   }
   if (needGradient)
   {
@@ -981,16 +979,16 @@ void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtk
   {
     // Labels are never interpolated; a mask on another grid is put on
     // the input's by nearest neighbour in world space.
-    mmrtm::HostVolume m = mmrtm::ImageDataToHostVolume(
-      mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
+    mmrtm::HostVolume m =
+      mmrtm::ImageDataToHostVolume(mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
     m = mmrtm::AlignLabelsToVolume(std::move(m), scene.proxies[0]);
     (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
     scene.proxies.push_back(std::move(m));
   }
   if (scene.proxies.size() > mmrtm::kMaxProxies)
     throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
-      std::to_string(scene.proxies.size()) + " proxy volumes; at most " +
-      std::to_string(mmrtm::kMaxProxies) + " are supported");
+      std::to_string(scene.proxies.size()) + " proxy volumes; at most " + std::to_string(mmrtm::kMaxProxies) +
+      " are supported");
 }
 
 void vtkMultiMaterialVolumeMapper::UpdateEnvironment()
@@ -1021,7 +1019,8 @@ void vtkMultiMaterialVolumeMapper::UpdateEnvironment()
   // sRGB bytes to linear; float data is radiance already. VTK's rows run
   // bottom up, the environment's from the zenith down.
   const bool bytes = a->GetDataType() == VTK_UNSIGNED_CHAR;
-  auto linear = [bytes](double v) {
+  auto linear = [bytes](double v)
+  {
     if (!bytes)
       return static_cast<float>(std::max(v, 0.0));
     v /= 255.0;
@@ -1046,7 +1045,7 @@ void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
   Internals& in = *this->Internal;
   nlohmann::json doc = nlohmann::json::parse(in.MultiMaterial->GetSceneJSON());
   doc.erase("camera");
-  doc.erase("volumes");  // a description's own files are not the mapper's data
+  doc.erase("volumes"); // a description's own files are not the mapper's data
   mmrtm::SceneInputs inputs;
   inputs.volumes["scalars"] = std::move(in.Scene.proxies[0]);
   for (size_t i = 1; i < in.Scene.proxies.size(); ++i)
@@ -1066,7 +1065,7 @@ void vtkMultiMaterialVolumeMapper::ReparseMultiMaterialScene()
   // grid's summaries go over to the new scene when its proxies are those
   // very buffers, so that the edit costs a refit.
   Internals& in = *this->Internal;
-  in.HasScene = false;  // until the parse succeeds; after a failure the input is read again
+  in.HasScene = false; // until the parse succeeds; after a failure the input is read again
   mmrtm::Scene previous = std::move(in.Scene);
   in.Scene = mmrtm::Scene();
   in.Layout = mmrtm::ProxyLayout();

@@ -39,11 +39,11 @@
 #ifndef vtkMultiMaterialVolumeMapper_h
 #define vtkMultiMaterialVolumeMapper_h
 
-#include "mmrtmRenderingModule.h"  // for export macro
+#include "mmrtmRenderingModule.h" // for export macro
 #include "vtkVolumeMapper.h"
 
-#include <memory>  // for std::unique_ptr
-#include <vector>  // for std::vector
+#include <memory> // for std::unique_ptr
+#include <vector> // for std::vector
 
 class vtkDataArray;
 class vtkImageData;

@@ -51,13 +51,15 @@ class CudaBackend : public Renderer {
         targets[i] = film.PixelSamples((int)(i % film.Width()), (int)(i / film.Width())) + (uint32_t)spp;
       return RenderTo(scene, view, film, targets, counters, progress, cancel);
     }
-    return Run(scene, view, [&] { gpu_.Render(film, spp, counters, progress); },
-               [&](Renderer& cpu) { return cpu.Render(scene, view, film, spp, counters, progress, cancel); });
+    return Run(
+        scene, view, [&] { gpu_.Render(film, spp, counters, progress); },
+        [&](Renderer& cpu) { return cpu.Render(scene, view, film, spp, counters, progress, cancel); });
   }
   bool RenderTo(const Scene& scene, const SceneView& view, Film& film, const std::vector<uint32_t>& targetCounts,
                 TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) override {
-    return Run(scene, view, [&] { gpu_.RenderTo(film, targetCounts, counters, progress); },
-               [&](Renderer& cpu) { return cpu.RenderTo(scene, view, film, targetCounts, counters, progress, cancel); });
+    return Run(
+        scene, view, [&] { gpu_.RenderTo(film, targetCounts, counters, progress); },
+        [&](Renderer& cpu) { return cpu.RenderTo(scene, view, film, targetCounts, counters, progress, cancel); });
   }
 
  private:

@@ -49,14 +49,13 @@ class Renderer {
   // CUDA pass, short, runs to its end).
   using Progress = std::function<void(int, int)>;
   virtual bool Render(const Scene& scene, const SceneView& view, Film& film, int samplesPerPixel,
-                      TraceCounters* counters, const Progress& progress,
-                      const std::atomic<bool>* cancel = nullptr) = 0;
+                      TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel = nullptr) = 0;
   // Adaptive sampling: adds samples to pixel i (row-major) until it has
   // targetCounts[i]; sample indices continue from each pixel's own count.
   // Afterwards the film has per-pixel counts (Film::Adaptive).
   virtual bool RenderTo(const Scene& scene, const SceneView& view, Film& film,
-                        const std::vector<uint32_t>& targetCounts, TraceCounters* counters,
-                        const Progress& progress, const std::atomic<bool>* cancel = nullptr) = 0;
+                        const std::vector<uint32_t>& targetCounts, TraceCounters* counters, const Progress& progress,
+                        const std::atomic<bool>* cancel = nullptr) = 0;
 };
 
 // `note` receives one-line remarks for the user (why auto chose the CPU, a

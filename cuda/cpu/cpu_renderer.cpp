@@ -33,15 +33,16 @@ bool CpuRenderer::RenderTo(const SceneView& scene, Film& film, const std::vector
   std::vector<uint32_t> counts(pixels);
   for (size_t i = 0; i < pixels; ++i)
     counts[i] = std::max(film.PixelSamples((int)(i % film.Width()), (int)(i / film.Width())), targetCounts[i]);
-  if (!RenderRanges(scene, film, [&](size_t pixel, uint32_t) { return counts[pixel]; }, counters, progress, cancel))
+  if (!RenderRanges(
+          scene, film, [&](size_t pixel, uint32_t) { return counts[pixel]; }, counters, progress, cancel))
     return false;
   film.SetPixelSamples(std::move(counts));
   return true;
 }
 
-bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film,
-                               const std::function<uint32_t(size_t, uint32_t)>& end, TraceCounters* counters,
-                               const Progress& progress, const std::atomic<bool>* cancel) const {
+bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::function<uint32_t(size_t, uint32_t)>& end,
+                               TraceCounters* counters, const Progress& progress,
+                               const std::atomic<bool>* cancel) const {
   const int width = film.Width(), height = film.Height();
   const int tilesX = (width + kTileSize - 1) / kTileSize, tilesY = (height + kTileSize - 1) / kTileSize;
   const int tileCount = tilesX * tilesY;

@@ -7,8 +7,7 @@
 
 namespace mmrtm {
 
-FeatureImages RenderFeatureImages(const SceneView& scene, int samplesPerPixel, int threads,
-                                  TraceCounters* counters) {
+FeatureImages RenderFeatureImages(const SceneView& scene, int samplesPerPixel, int threads, TraceCounters* counters) {
   const int width = scene.camera.width, height = scene.camera.height;
   FeatureImages out;
   out.albedo = RGBImage{width, height, std::vector<RGB>((size_t)width * height)};

@@ -31,8 +31,8 @@ CudaDeviceStatus Query() {
   // The fat binary holds sm_75, sm_86, sm_89 and sm_90 (+PTX for later
   // devices); anything older cannot run it.
   if (prop.major < 7 || (prop.major == 7 && prop.minor < 5)) {
-    s.reason = std::string("CUDA device ") + prop.name + " has compute capability " + std::to_string(prop.major) +
-               "." + std::to_string(prop.minor) + "; 7.5 or later is needed";
+    s.reason = std::string("CUDA device ") + prop.name + " has compute capability " + std::to_string(prop.major) + "." +
+               std::to_string(prop.minor) + "; 7.5 or later is needed";
     return s;
   }
   s.available = true;

@@ -48,8 +48,8 @@ class DeviceBuffer {
     if (status != cudaSuccess) {
       cudaGetLastError();
       ptr_ = nullptr;
-      throw DeviceMemoryError("cudaMalloc of " + Megabytes(bytes) + " for " + what + " failed: " +
-                              cudaGetErrorString(status));
+      throw DeviceMemoryError("cudaMalloc of " + Megabytes(bytes) + " for " + what +
+                              " failed: " + cudaGetErrorString(status));
     }
     bytes_ = bytes;
   }
@@ -63,7 +63,9 @@ class DeviceBuffer {
 
   void* Get() const { return ptr_; }
   template <typename T>
-  T* As() const { return static_cast<T*>(ptr_); }
+  T* As() const {
+    return static_cast<T*>(ptr_);
+  }
   size_t Bytes() const { return bytes_; }
 
   static std::string Megabytes(size_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }

@@ -81,8 +81,8 @@ struct GpuRenderer::Impl {
   float* majorants = nullptr;        // inside `tables`
   uint8_t* minorants = nullptr;      // inside `tables`, as many
   size_t majorantCount = 0;
-  DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, summaryLowerBounds, binMax, binMaterials,
-      binMin, uncoveredBins;
+  DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, summaryLowerBounds, binMax, binMaterials, binMin,
+      uncoveredBins;
   DeviceBuffer filmMean, filmM2, filmEven, filmWork, counters, rangeFirst, rangeEnd;
   int filmWidth = 0, filmHeight = 0;
   uint32_t filmSamples = 0;
@@ -109,8 +109,12 @@ struct GpuRenderer::Impl {
     filmHeight = host.height;
   }
   FilmView DeviceFilm() {
-    return FilmView{filmWidth, filmHeight, filmMean.As<float>(), filmM2.As<float>(),
-                    hasWork ? filmWork.As<float>() : nullptr, filmEven.As<float>()};
+    return FilmView{filmWidth,
+                    filmHeight,
+                    filmMean.As<float>(),
+                    filmM2.As<float>(),
+                    hasWork ? filmWork.As<float>() : nullptr,
+                    filmEven.As<float>()};
   }
   void DownloadFilm(const FilmView& host) const {
     const size_t pixels = (size_t)host.width * host.height;
@@ -131,8 +135,7 @@ struct GpuRenderer::Impl {
     scene.camera.height = filmHeight;
     const FilmView film = DeviceFilm();
     MMRTM_CUDA_CHECK(cudaMemset(counters.Get(), 0, sizeof(TraceCounters)));
-    const dim3 block(kBlockX, kBlockY),
-        grid((filmWidth + kBlockX - 1) / kBlockX, (filmHeight + kBlockY - 1) / kBlockY);
+    const dim3 block(kBlockX, kBlockY), grid((filmWidth + kBlockX - 1) / kBlockX, (filmHeight + kBlockY - 1) / kBlockY);
     for (uint32_t index = from; index < to; ++index) {
       RenderSampleKernel<<<grid, block>>>(scene, film, index, first, end, counters.As<TraceCounters>());
       MMRTM_CUDA_CHECK(cudaGetLastError());
@@ -148,7 +151,6 @@ struct GpuRenderer::Impl {
       *out += c;
     }
   }
-
 };
 
 GpuRenderer::GpuRenderer() : impl_(new Impl) {
@@ -276,8 +278,7 @@ void GpuRenderer::Refit(const MajorantGrid& grid, const Classifier& classifier, 
 
 std::vector<uint8_t> GpuRenderer::DownloadMinorants() const {
   std::vector<uint8_t> out(impl_->minorants ? impl_->majorantCount : 0);
-  if (!out.empty())
-    MMRTM_CUDA_CHECK(cudaMemcpy(out.data(), impl_->minorants, out.size(), cudaMemcpyDeviceToHost));
+  if (!out.empty()) MMRTM_CUDA_CHECK(cudaMemcpy(out.data(), impl_->minorants, out.size(), cudaMemcpyDeviceToHost));
   return out;
 }
 

@@ -48,8 +48,7 @@ class GpuRenderer {
   // indices continue from film.Samples(), so a CPU and a GPU render of one
   // seed take the same random numbers.
   using Progress = std::function<void(int, int)>;
-  void Render(Film& film, int samplesPerPixel, TraceCounters* counters = nullptr,
-              const Progress& progress = nullptr);
+  void Render(Film& film, int samplesPerPixel, TraceCounters* counters = nullptr, const Progress& progress = nullptr);
   // Adaptive sampling: adds samples to pixel i until it has targetCounts[i]
   // (indices continue from each pixel's own count, as on the CPU). The film
   // goes up and comes back on every call; `film` may be uniform or adaptive.

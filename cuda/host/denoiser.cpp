@@ -87,8 +87,10 @@ std::unique_ptr<Denoiser> Denoiser::Load(int threads) {
     tried += "\n  " + candidate + ": " + error;
   }
   if (!api->library)
-    throw DenoiserError("Intel Open Image Denoise not found (scripts/install-dependencies.sh installs the `oidn` "
-                        "wheel into .venv; MMRTM_OIDN_LIBRARY names a library). Tried:" + tried);
+    throw DenoiserError(
+        "Intel Open Image Denoise not found (scripts/install-dependencies.sh installs the `oidn` "
+        "wheel into .venv; MMRTM_OIDN_LIBRARY names a library). Tried:" +
+        tried);
   Api& a = *api;
   Bind(a.library, "oidnNewDevice", &a.newDevice, path);
   Bind(a.library, "oidnSetDeviceInt", &a.setDeviceInt, path, "oidnSetDevice1i");
@@ -132,7 +134,8 @@ RGBImage Denoiser::Denoise(const RGBImage& color, const RGBImage* albedo, const 
   const auto sameSize = [&](const RGBImage* image) {
     return !image || (image->width == color.width && image->height == color.height);
   };
-  if (!sameSize(albedo) || !sameSize(normal)) throw DenoiserError("the albedo or normal image is not the colour's size");
+  if (!sameSize(albedo) || !sameSize(normal))
+    throw DenoiserError("the albedo or normal image is not the colour's size");
   RGBImage out{color.width, color.height, std::vector<RGB>(color.pixels.size())};
   const auto share = [&](void* filter, const char* name, const RGBImage& image) {
     a.setSharedFilterImage(filter, name, const_cast<RGB*>(image.pixels.data()), kFormatFloat3, (size_t)image.width,

@@ -49,8 +49,8 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<RGB> texels)
   marginalIntegral_ = BuildCdf(marginalFunc_.data(), height_, marginalCdf_.data());
   rows_.resize(height_);
   for (int y = 0; y < height_; ++y)
-    rows_[y] = Distribution1DView{&rowFunc_[(size_t)y * width_], &rowCdf_[(size_t)y * (width_ + 1)], width_,
-                                  marginalFunc_[y]};
+    rows_[y] =
+        Distribution1DView{&rowFunc_[(size_t)y * width_], &rowCdf_[(size_t)y * (width_ + 1)], width_, marginalFunc_[y]};
 }
 
 EnvironmentView EnvironmentMap::View() const {

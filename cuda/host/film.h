@@ -12,11 +12,11 @@
 namespace mmrtm {
 
 struct NoiseEstimate {
-  double meanLuminance = 0;     // over all pixels
+  double meanLuminance = 0;  // over all pixels
   // Root mean square over pixels of the standard error of the luminance
   // mean, from the difference of the two replicates' means (Film::Noise).
   double rmsStandardError = 0;
-  double relative = 0;          // rmsStandardError / meanLuminance
+  double relative = 0;  // rmsStandardError / meanLuminance
 };
 
 class Film;
@@ -32,8 +32,8 @@ class Film {
   Film(int width, int height);
 
   FilmView View() {
-    return FilmView{width_, height_, mean_.data(), m2_.data(), work_.empty() ? nullptr : work_.data(),
-                    evenLuminance_.data()};
+    return FilmView{
+        width_, height_, mean_.data(), m2_.data(), work_.empty() ? nullptr : work_.data(), evenLuminance_.data()};
   }
   void Reset();
   int Width() const { return width_; }
@@ -47,9 +47,7 @@ class Film {
   // Adaptive sampling: pixels with their own sample counts. A film is
   // uniform until SetPixelSamples; Reset makes it uniform again.
   bool Adaptive() const { return !pixelSamples_.empty(); }
-  uint32_t PixelSamples(int x, int y) const {
-    return Adaptive() ? pixelSamples_[(size_t)y * width_ + x] : samples_;
-  }
+  uint32_t PixelSamples(int x, int y) const { return Adaptive() ? pixelSamples_[(size_t)y * width_ + x] : samples_; }
   double MeanSamples() const;
   uint32_t MaxSamples() const;
   // Records the per-pixel counts after a pass that brought pixel i to

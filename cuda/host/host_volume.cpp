@@ -38,10 +38,14 @@ VolumeView HostVolume::View() const {
 
 float HostVolume::Value(int64_t i) const {
   switch (type) {
-    case VoxelType::UInt8: return (float)voxels[i];
-    case VoxelType::Int16: return (float)reinterpret_cast<const int16_t*>(voxels.data())[i];
-    case VoxelType::UInt16: return (float)reinterpret_cast<const uint16_t*>(voxels.data())[i];
-    default: return reinterpret_cast<const float*>(voxels.data())[i];
+    case VoxelType::UInt8:
+      return (float)voxels[i];
+    case VoxelType::Int16:
+      return (float)reinterpret_cast<const int16_t*>(voxels.data())[i];
+    case VoxelType::UInt16:
+      return (float)reinterpret_cast<const uint16_t*>(voxels.data())[i];
+    default:
+      return reinterpret_cast<const float*>(voxels.data())[i];
   }
 }
 
@@ -63,10 +67,14 @@ std::array<float, 2> TypedRange(const T* v, int64_t n) {
 std::array<float, 2> HostVolume::ValueRange() const {
   const int64_t n = VoxelCount();
   switch (type) {
-    case VoxelType::UInt8: return TypedRange(voxels.data(), n);
-    case VoxelType::Int16: return TypedRange(reinterpret_cast<const int16_t*>(voxels.data()), n);
-    case VoxelType::UInt16: return TypedRange(reinterpret_cast<const uint16_t*>(voxels.data()), n);
-    default: return TypedRange(reinterpret_cast<const float*>(voxels.data()), n);
+    case VoxelType::UInt8:
+      return TypedRange(voxels.data(), n);
+    case VoxelType::Int16:
+      return TypedRange(reinterpret_cast<const int16_t*>(voxels.data()), n);
+    case VoxelType::UInt16:
+      return TypedRange(reinterpret_cast<const uint16_t*>(voxels.data()), n);
+    default:
+      return TypedRange(reinterpret_cast<const float*>(voxels.data()), n);
   }
 }
 
@@ -115,8 +123,7 @@ void HostVolume::Validate() const {
   const VolumeView view = View();  // throws on singular geometry
   for (const auto& row : view.worldToIndex.m)
     for (float v : row)
-      if (!std::isfinite(v))
-        throw InputError(where + ": its spacing or direction is too close to singular to invert");
+      if (!std::isfinite(v)) throw InputError(where + ": its spacing or direction is too close to singular to invert");
 }
 
 Affine3 IndexToWorld(const std::array<double, 3>& origin, const std::array<double, 3>& spacing,

@@ -31,10 +31,10 @@ struct HostVolume {
   // How messages name the volume: its source, else its proxy name.
   const std::string& Where() const { return source.empty() ? name : source; }
   int64_t VoxelCount() const { return (int64_t)dims[0] * dims[1] * dims[2]; }
-  VolumeView View() const;                      // throws if the geometry is singular
-  float Value(int64_t i) const;                 // voxel i converted to float
-  std::array<float, 2> ValueRange() const;      // min and max voxel value
-  std::array<Vec3, 2> WorldBounds() const;      // axis-aligned world box of the domain
+  VolumeView View() const;                  // throws if the geometry is singular
+  float Value(int64_t i) const;             // voxel i converted to float
+  std::array<float, 2> ValueRange() const;  // min and max voxel value
+  std::array<Vec3, 2> WorldBounds() const;  // axis-aligned world box of the domain
   Vec3 WorldCenter() const;
 
   // Checks dims, buffer size and (for float voxels) finiteness; throws

@@ -155,7 +155,8 @@ RGBImage ReadRGBE(const std::string& path) {
     for (int x = 0; x < w; ++x) {
       const uint8_t* p = &scan[(size_t)x * 4];
       float f = p[3] ? std::ldexp(1.f, (int)p[3] - (128 + 8)) : 0.f;
-      image.pixels[(size_t)y * w + x] = RGB((p[0] + 0.5f) * f, (p[1] + 0.5f) * f, (p[2] + 0.5f) * f) * (p[3] ? 1.f : 0.f);
+      image.pixels[(size_t)y * w + x] =
+          RGB((p[0] + 0.5f) * f, (p[1] + 0.5f) * f, (p[2] + 0.5f) * f) * (p[3] ? 1.f : 0.f);
     }
   }
   return image;
@@ -202,8 +203,7 @@ void WritePNG(const std::string& path, int width, int height, int channels, cons
     png_set_IHDR(png, info, width, height, 8, channels == 4 ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
-    for (int y = 0; y < height; ++y)
-      png_write_row(png, const_cast<png_bytep>(&pixels[(size_t)y * width * channels]));
+    for (int y = 0; y < height; ++y) png_write_row(png, const_cast<png_bytep>(&pixels[(size_t)y * width * channels]));
     png_write_end(png, nullptr);
     png_destroy_write_struct(&png, &info);
     return true;

@@ -95,10 +95,18 @@ std::vector<int> LabelIdsPresent(const HostVolume& labels) {
   const int64_t n = labels.VoxelCount();
   const void* p = labels.voxels.data();
   switch (labels.type) {
-    case VoxelType::UInt8: CollectIds(static_cast<const uint8_t*>(p), n, ids, labels); break;
-    case VoxelType::Int16: CollectIds(static_cast<const int16_t*>(p), n, ids, labels); break;
-    case VoxelType::UInt16: CollectIds(static_cast<const uint16_t*>(p), n, ids, labels); break;
-    case VoxelType::Float32: CollectIds(static_cast<const float*>(p), n, ids, labels); break;
+    case VoxelType::UInt8:
+      CollectIds(static_cast<const uint8_t*>(p), n, ids, labels);
+      break;
+    case VoxelType::Int16:
+      CollectIds(static_cast<const int16_t*>(p), n, ids, labels);
+      break;
+    case VoxelType::UInt16:
+      CollectIds(static_cast<const uint16_t*>(p), n, ids, labels);
+      break;
+    case VoxelType::Float32:
+      CollectIds(static_cast<const float*>(p), n, ids, labels);
+      break;
   }
   return {ids.begin(), ids.end()};
 }
@@ -150,8 +158,7 @@ json LabelMaterial(const LabelLook& look) {
   json m = json::object();
   m["density"] = look.visible ? kLabelDensityAtFullOpacity * look.opacity : 0.0;
   m["albedo"] = json::array({look.color[0], look.color[1], look.color[2]});
-  static const std::set<std::string> known = {"roughness", "metallic", "surface_probability", "anisotropy",
-                                              "emission"};
+  static const std::set<std::string> known = {"roughness", "metallic", "surface_probability", "anisotropy", "emission"};
   for (const auto& [key, value] : look.surface.items()) {
     if (!known.count(key))
       Fail(where, "unknown key '" + key + "' (roughness, metallic, surface_probability, anisotropy, emission)");

@@ -68,8 +68,7 @@ LabelTable ReadLabelTable(const std::string& path) {
     if (numeric) {
       for (size_t k = 0; k < extra; ++k)
         if (c[k] != std::floor(c[k]) || c[k] < 0 || c[k] > 255)
-          throw InputError(where + "colour value '" + t[2 + k] + "' of label " + t[0] +
-                           " is not an integer in 0-255");
+          throw InputError(where + "colour value '" + t[2 + k] + "' of label " + t[0] + " is not an integer in 0-255");
       e.color = RGB((float)(c[0] / 255), (float)(c[1] / 255), (float)(c[2] / 255));
       e.opacity = (float)(c[3] / 255);
       e.hasColor = true;
@@ -93,12 +92,18 @@ RGB DefaultLabelColor(int id) {
   const float f = (float)(h - sector);
   const float p = v * (1 - s), q = v * (1 - s * f), r = v * (1 - s * (1 - f));
   switch (sector) {
-    case 0: return RGB(v, r, p);
-    case 1: return RGB(q, v, p);
-    case 2: return RGB(p, v, r);
-    case 3: return RGB(p, q, v);
-    case 4: return RGB(r, p, v);
-    default: return RGB(v, p, q);
+    case 0:
+      return RGB(v, r, p);
+    case 1:
+      return RGB(q, v, p);
+    case 2:
+      return RGB(p, v, r);
+    case 3:
+      return RGB(p, q, v);
+    case 4:
+      return RGB(r, p, v);
+    default:
+      return RGB(v, p, q);
   }
 }
 

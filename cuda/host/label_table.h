@@ -19,8 +19,8 @@ struct LabelEntry {
 };
 
 struct LabelTable {
-  std::string source;               // the file, for messages
-  std::vector<LabelEntry> entries;  // in file order; ids are unique
+  std::string source;                    // the file, for messages
+  std::vector<LabelEntry> entries;       // in file order; ids are unique
   const LabelEntry* Find(int id) const;  // null if absent
 };
 

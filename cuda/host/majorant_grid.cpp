@@ -21,8 +21,8 @@ double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 // the bin of the min and max of an edge are the min and max of its bins).
 template <typename T>
 void SummarizeBlock(const T* data, const std::array<int, 3>& dims, const int lo[3], const int hi[3],
-                    const MajorantGrid::BinMap& bins, const std::vector<int16_t>& binTable, int binTableMin,
-                    bool edges, uint64_t* words, std::vector<int16_t>& scratch) {
+                    const MajorantGrid::BinMap& bins, const std::vector<int16_t>& binTable, int binTableMin, bool edges,
+                    uint64_t* words, std::vector<int16_t>& scratch) {
   const int nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1, nz = hi[2] - lo[2] + 1;
   scratch.resize((size_t)nx * ny * nz);
   for (int z = 0; z < nz; ++z)
@@ -130,8 +130,8 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
   const int leafSize = leafSizeAt(leafLevel);
   float maxSpacing = 0.f;
   for (int a = 0; a < 3; ++a)
-    maxSpacing = std::max(maxSpacing, Length(Vec3{v0.indexToWorld.m[0][a], v0.indexToWorld.m[1][a],
-                                                  v0.indexToWorld.m[2][a]}));
+    maxSpacing =
+        std::max(maxSpacing, Length(Vec3{v0.indexToWorld.m[0][a], v0.indexToWorld.m[1][a], v0.indexToWorld.m[2][a]}));
   int64_t offset = 0;
   for (int l = 0; l <= leafLevel; ++l) {
     view_.nodeSize[l] = leafSize << (leafLevel - l);
@@ -219,14 +219,15 @@ void MajorantGrid::UpdateRegion(const std::vector<HostVolume>& proxies, std::arr
   buildSeconds_ = SecondsSince(start);
 }
 
-void MajorantGrid::BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3],
-                               const int hi[3], uint64_t* tuples) {
+void MajorantGrid::BuildLeaves(const std::vector<HostVolume>& proxies, int z0, int z1, const int lo[3], const int hi[3],
+                               uint64_t* tuples) {
   const size_t stride = (size_t)proxyCount_ * kSummaryWords;
   const int64_t nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1;
   for (int z = z0; z < z1; ++z)
     for (int y = lo[1]; y <= hi[1]; ++y)
       for (int x = lo[0]; x <= hi[0]; ++x)
-        SummarizeLeaf(proxies, x, y, z, tuples + stride * (size_t)((x - lo[0]) + nx * ((y - lo[1]) + ny * (z - lo[2]))));
+        SummarizeLeaf(proxies, x, y, z,
+                      tuples + stride * (size_t)((x - lo[0]) + nx * ((y - lo[1]) + ny * (z - lo[2]))));
 }
 
 void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz, uint64_t* tuple) {
@@ -272,16 +273,16 @@ void MajorantGrid::SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx,
         SummarizeBlock(v.voxels.data(), v.dims, lo, hi, bins_[k], table, tableMin, edges, words, scratch);
         break;
       case VoxelType::Int16:
-        SummarizeBlock(reinterpret_cast<const int16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin, edges, words,
-                       scratch);
+        SummarizeBlock(reinterpret_cast<const int16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin,
+                       edges, words, scratch);
         break;
       case VoxelType::UInt16:
-        SummarizeBlock(reinterpret_cast<const uint16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin, edges, words,
-                       scratch);
+        SummarizeBlock(reinterpret_cast<const uint16_t*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin,
+                       edges, words, scratch);
         break;
       case VoxelType::Float32:
-        SummarizeBlock(reinterpret_cast<const float*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin, edges, words,
-                       scratch);
+        SummarizeBlock(reinterpret_cast<const float*>(v.voxels.data()), v.dims, lo, hi, bins_[k], table, tableMin,
+                       edges, words, scratch);
         break;
     }
   }
@@ -297,7 +298,8 @@ void MajorantGrid::RefitFromVoxelValues(const Classifier& c) {
   const int* res = view_.res[L];
   ParallelFor(LeafCount(), options_.threads, [&](int64_t begin, int64_t end) {
     for (int64_t leaf = begin; leaf < end; ++leaf) {
-      const int cell[3] = {(int)(leaf % res[0]), (int)((leaf / res[0]) % res[1]), (int)(leaf / ((int64_t)res[0] * res[1]))};
+      const int cell[3] = {(int)(leaf % res[0]), (int)((leaf / res[0]) % res[1]),
+                           (int)(leaf / ((int64_t)res[0] * res[1]))};
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
         lo[a] = cell[a] * size;

@@ -60,7 +60,7 @@ struct MajorantGridOptions {
   int leafLevel = -1;  // -1: the finest level with at most kMaxAutoLeaves leaves
   int margin = 0;      // voxel cells around each leaf included in its summary
   SummaryMode summary = SummaryMode::CellRanges;
-  int threads = 0;     // 0: all hardware threads
+  int threads = 0;  // 0: all hardware threads
 };
 
 // The automatic leaf level: the finest whose leaf count stays within this

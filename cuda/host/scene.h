@@ -20,21 +20,21 @@ struct TransferFunctionDesc {
   TFType type = TFType::CCTF;
   int proxy = 0;
   int channels = 1;
-  std::vector<float> keys;    // see TransferFunctionView for the layout
-  std::vector<float> values;  // coefficient TFs
-  std::vector<int> materials; // material TFs
+  std::vector<float> keys;     // see TransferFunctionView for the layout
+  std::vector<float> values;   // coefficient TFs
+  std::vector<int> materials;  // material TFs
 };
 
 struct MaterialDesc {
   std::string name;
   float base[kCoefficientFloats] = {
-      1.f,            // density
-      1.f, 1.f, 1.f,  // albedo
-      0.5f,           // roughness
-      0.f,            // metallic
-      0.f,            // surface probability
-      0.f, 0.f, 0.f,  // emission
-      0.f             // anisotropy g
+      1.f,             // density
+      1.f,  1.f, 1.f,  // albedo
+      0.5f,            // roughness
+      0.f,             // metallic
+      0.f,             // surface probability
+      0.f,  0.f, 0.f,  // emission
+      0.f              // anisotropy g
   };
   struct Binding {
     int tf;
@@ -52,10 +52,10 @@ struct CameraDesc {
   float azimuth = 0.f, elevation = 0.f, zoom = 1.f;
   // Explicit placement (autoFrame false).
   Vec3 position, lookAt, up{0.f, 0.f, 1.f};
-  float fovY = 30.f;         // degrees, perspective
-  float orthoHeight = 0.f;   // world units, orthographic; 0 fits the volume
-  float lensRadius = 0.f;    // world units; 0 is a pinhole
-  float focusDistance = 0.f; // world units; 0 focuses on the look-at point
+  float fovY = 30.f;          // degrees, perspective
+  float orthoHeight = 0.f;    // world units, orthographic; 0 fits the volume
+  float lensRadius = 0.f;     // world units; 0 is a pinhole
+  float focusDistance = 0.f;  // world units; 0 focuses on the look-at point
 };
 
 // Which majorants the trackers use (MajorantKind), and how the grid is laid
@@ -161,7 +161,7 @@ class Scene {
   std::vector<Light> lightViews_;
   std::unique_ptr<MajorantGrid> grid_;
   std::vector<std::array<float, 2>> valueRanges_;  // per proxy, at the last data load
-  std::vector<const uint8_t*> summarisedVoxels_;    // per proxy, the buffers of the last data load
+  std::vector<const uint8_t*> summarisedVoxels_;   // per proxy, the buffers of the last data load
   bool dataModified_ = true;
   bool gridBuilt_ = false;
   bool gridRefitted_ = false;

@@ -285,7 +285,8 @@ class Parser {
     for (size_t i = 0; i < volumeNames_.size(); ++i)
       if (volumeNames_[i] == proxy && !derived_[i]) index = (int)i;
     if (index < 0)
-      Fail("label_materials.proxy", "needs the label map '" + proxy + "' (give --labels FILE, or a volume of that name)");
+      Fail("label_materials.proxy",
+           "needs the label map '" + proxy + "' (give --labels FILE, or a volume of that name)");
     doc_ = ExpandLabelMaterials(doc_, LabelIdsPresent(volumes_[index]), table ? &*table : nullptr);
   }
 
@@ -367,7 +368,8 @@ class Parser {
     for (size_t i = 0; i < list.size(); ++i) {
       const std::string w = where + "." + listKey + "[" + std::to_string(i) + "]";
       const json& e = list[i];
-      if (!e.is_array() || e.size() < keyCount + 1) Fail(w, range ? "expected [low, high, value...]" : "expected [value, coefficient...]");
+      if (!e.is_array() || e.size() < keyCount + 1)
+        Fail(w, range ? "expected [low, high, value...]" : "expected [value, coefficient...]");
       for (size_t k = 0; k < keyCount; ++k) tf.keys.push_back(Number(e[k], w));
       if (material) {
         if (e.size() != keyCount + 1 || !e[keyCount].is_string()) Fail(w, "expected a material name after the key");
@@ -482,8 +484,8 @@ class Parser {
         CheckKeys(lj, w, {"type", "file", "sky", "color", "intensity"});
         if (scene_.environment) Fail(w, "only one environment light is supported");
         if (lj.contains("file")) {
-          scene_.environment =
-              EnvironmentMap::Load(Resolve(StringOr(lj, "file", "", w), in_.baseDirectory), Radiance(RGB(1.f), intensity, w)[0]);
+          scene_.environment = EnvironmentMap::Load(Resolve(StringOr(lj, "file", "", w), in_.baseDirectory),
+                                                    Radiance(RGB(1.f), intensity, w)[0]);
         } else if (lj.contains("color")) {
           scene_.environment = EnvironmentMap::Constant(Radiance(color, intensity, w));
         } else {
@@ -567,10 +569,14 @@ class Parser {
       r.integrator.sampler = *pixelSampler;
       const std::string acc = StringOr(rj, "accelerator", "octree", w);
       AcceleratorSettings& a = r.accelerator;
-      if (acc == "none") a.kind = MajorantKind::Global;
-      else if (acc == "macrocell") a.kind = MajorantKind::Macrocell;
-      else if (acc == "octree" || acc == "octree-voxelmax") a.kind = MajorantKind::Octree;
-      else Fail(w + ".accelerator", "expected none, macrocell, octree or octree-voxelmax, got '" + acc + "'");
+      if (acc == "none")
+        a.kind = MajorantKind::Global;
+      else if (acc == "macrocell")
+        a.kind = MajorantKind::Macrocell;
+      else if (acc == "octree" || acc == "octree-voxelmax")
+        a.kind = MajorantKind::Octree;
+      else
+        Fail(w + ".accelerator", "expected none, macrocell, octree or octree-voxelmax, got '" + acc + "'");
       a.grid.summary = acc == "octree-voxelmax" ? SummaryMode::VoxelValues : SummaryMode::CellRanges;
       a.grid.leafLevel = IntegerOr(rj, "leaf_level", a.grid.leafLevel, w);
       if (a.grid.leafLevel < -1 || a.grid.leafLevel >= kMaxGridLevels)
@@ -663,9 +669,12 @@ std::optional<LightSampling> ParseLightSampling(const std::string& name) {
 
 const char* LightSamplingName(LightSampling mode) {
   switch (mode) {
-    case LightSampling::One: return "one";
-    case LightSampling::All: return "all";
-    case LightSampling::Resampled: return "resampled";
+    case LightSampling::One:
+      return "one";
+    case LightSampling::All:
+      return "all";
+    case LightSampling::Resampled:
+      return "resampled";
   }
   return "one";
 }

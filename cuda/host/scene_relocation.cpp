@@ -56,8 +56,9 @@ void ForEachArray(SceneView& s, Visit visit) {
   c.selectors = visit(c.selectors, (size_t)c.selectorCount, SceneArrayKind::Tables);
 
   s.majorants.grid.majorants = visit(s.majorants.grid.majorants, MajorantCount(s.majorants), SceneArrayKind::Majorants);
-  s.majorants.grid.minorants = visit(s.majorants.grid.minorants, s.majorants.grid.minorants ? MajorantCount(s.majorants) : 0,
-                                     SceneArrayKind::Minorants);
+  s.majorants.grid.minorants =
+      visit(s.majorants.grid.minorants, s.majorants.grid.minorants ? MajorantCount(s.majorants) : 0,
+            SceneArrayKind::Minorants);
   s.lights = visit(s.lights, (size_t)s.lightCount, SceneArrayKind::Tables);
   s.cameraRayMaxDistance =
       visit(s.cameraRayMaxDistance, (size_t)s.camera.width * s.camera.height, SceneArrayKind::Tables);
@@ -89,11 +90,21 @@ SceneFootprint MeasureSceneView(const SceneView& scene) {
   ForEachArray(s, [&](auto* p, size_t count, SceneArrayKind kind) {
     const size_t bytes = p ? count * sizeof(*p) : 0;
     switch (kind) {
-      case SceneArrayKind::Voxels: f.voxels += bytes; break;
-      case SceneArrayKind::Tables: f.tables += bytes; break;
-      case SceneArrayKind::Majorants: f.majorants += bytes; break;
-      case SceneArrayKind::Minorants: f.minorants += bytes; break;
-      case SceneArrayKind::Environment: f.environment += bytes; break;
+      case SceneArrayKind::Voxels:
+        f.voxels += bytes;
+        break;
+      case SceneArrayKind::Tables:
+        f.tables += bytes;
+        break;
+      case SceneArrayKind::Majorants:
+        f.majorants += bytes;
+        break;
+      case SceneArrayKind::Minorants:
+        f.minorants += bytes;
+        break;
+      case SceneArrayKind::Environment:
+        f.environment += bytes;
+        break;
     }
     return p;
   });

@@ -74,7 +74,9 @@ int main(int argc, char** argv) {
   if (!QTest::qWaitFor([&] { return mapper->GetAccumulatedSamples() >= 1; }, 60000)) return 1;
   const qint64 first = sinceRelease.elapsed();
   if (!QTest::qWaitFor([&] { return mapper->GetAccumulatedSamples() >= 16; }, 300000)) return 1;
-  std::printf("after releasing a TF point: first full-resolution image %lld ms, 16 samples per pixel %lld ms; "
-              "last refit %.1f ms\n", first, sinceRelease.elapsed(), mapper->GetLastRefitSeconds() * 1000);
+  std::printf(
+      "after releasing a TF point: first full-resolution image %lld ms, 16 samples per pixel %lld ms; "
+      "last refit %.1f ms\n",
+      first, sinceRelease.elapsed(), mapper->GetLastRefitSeconds() * 1000);
   return 0;
 }

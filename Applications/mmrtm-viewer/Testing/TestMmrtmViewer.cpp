@@ -180,7 +180,8 @@ class TestMmrtmViewer : public QObject {
         if (c.value("ids", nlohmann::json::array()) == nlohmann::json::array({entry.id})) return c["material"];
       return nlohmann::json();
     };
-    QCOMPARE(labelMaterial()["density"].get<double>(), 0.8 * vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity());
+    QCOMPARE(labelMaterial()["density"].get<double>(),
+             0.8 * vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity());
     QCOMPARE(labelMaterial()["albedo"], nlohmann::json::array({0.0, 0.0, 1.0}));
     QVERIFY(RefineTo(v.window, 8));
     const QImage before = View(v.window);
@@ -205,7 +206,8 @@ class TestMmrtmViewer : public QObject {
             nearBlue = c.blue() > c.red() + 30 && c.blue() > c.green() + 30;
           }
         const QColor p = before.pixelColor(x, y), q = after.pixelColor(x, y);
-        const bool changed = std::abs(p.red() - q.red()) + std::abs(p.green() - q.green()) + std::abs(p.blue() - q.blue()) > 24;
+        const bool changed =
+            std::abs(p.red() - q.red()) + std::abs(p.green() - q.green()) + std::abs(p.blue() - q.blue()) > 24;
         const QColor c = p;
         if (c.blue() > c.red() + 30 && c.blue() > c.green() + 30) {
           ++blue;
@@ -226,8 +228,9 @@ class TestMmrtmViewer : public QObject {
     QTemporaryDir folder;
     for (const auto& source : {Data("ct_chest_dicom"), Data("ct_abdomen_dicom_j2k")})
       for (const auto& entry : fs::directory_iterator(source.toStdString()))
-        fs::copy_file(entry.path(), fs::path(folder.path().toStdString()) /
-                                        (QFileInfo(source).fileName().toStdString() + "_" + entry.path().filename().string()));
+        fs::copy_file(entry.path(),
+                      fs::path(folder.path().toStdString()) /
+                          (QFileInfo(source).fileName().toStdString() + "_" + entry.path().filename().string()));
     Viewer v;
     QVector<mmrtm::viewer::SeriesInfo> offered;
     v.window.setSeriesChooser([&](const QString&, const QVector<mmrtm::viewer::SeriesInfo>& series) {
@@ -268,9 +271,10 @@ class TestMmrtmViewer : public QObject {
     const QString far = folder.filePath("far_labels.nrrd");
     QFile labels(far);
     QVERIFY(labels.open(QIODevice::WriteOnly));
-    labels.write("NRRD0004\ntype: uchar\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 4 4\n"
-                 "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (10000,10000,10000)\n"
-                 "encoding: raw\n\n");
+    labels.write(
+        "NRRD0004\ntype: uchar\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 4 4\n"
+        "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (10000,10000,10000)\n"
+        "encoding: raw\n\n");
     labels.write(QByteArray(64, 1));
     labels.close();
     QVERIFY(!v.window.openLabels(far));
@@ -280,9 +284,10 @@ class TestMmrtmViewer : public QObject {
     const QString badCamera = folder.filePath("bad_camera.json");
     QFile sceneFile(badCamera);
     QVERIFY(sceneFile.open(QIODevice::WriteOnly));
-    sceneFile.write(QString(R"({"volumes": {"scalars": {"file": "%1"}}, "camera": {"position": [1, 2], "look_at": [0, 0, 0]}})")
-                        .arg(Data("ct_head_headsq.nrrd"))
-                        .toUtf8());
+    sceneFile.write(
+        QString(R"({"volumes": {"scalars": {"file": "%1"}}, "camera": {"position": [1, 2], "look_at": [0, 0, 0]}})")
+            .arg(Data("ct_head_headsq.nrrd"))
+            .toUtf8());
     sceneFile.close();
     v.error.clear();
     QVERIFY(!v.window.loadScene(badCamera));
@@ -350,7 +355,7 @@ class TestMmrtmViewer : public QObject {
     QVERIFY(RefineTo(*window, 2));
     QVERIFY(!window->scene().Mapper()->IsConverged());
     window->close();
-    delete window;  // with refinement steps scheduled
+    delete window;      // with refinement steps scheduled
     QTest::qWait(300);  // the event loop runs on: nothing refers to the window
   }
 
@@ -374,7 +379,9 @@ class TestMmrtmViewer : public QObject {
     // widget styles) at 1/8 of the size, within 6 %.
     const QRect view(v.window.view()->mapTo(&v.window, QPoint(0, 0)), v.window.view()->size());
     const double viewDifference = MeanDifference(window.copy(view), baseline.copy(view));
-    const auto coarse = [](const QImage& i) { return i.scaled(i.size() / 8, Qt::IgnoreAspectRatio, Qt::SmoothTransformation); };
+    const auto coarse = [](const QImage& i) {
+      return i.scaled(i.size() / 8, Qt::IgnoreAspectRatio, Qt::SmoothTransformation);
+    };
     const double windowDifference = MeanDifference(coarse(window), coarse(baseline));
     qInfo("view differs by %.4f, window (1/8 size) by %.4f; image in %s", viewDifference, windowDifference,
           qPrintable(temporary));

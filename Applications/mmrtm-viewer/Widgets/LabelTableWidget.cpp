@@ -21,14 +21,14 @@ QDoubleSpinBox* UnitSpinBox(double value) {
 
 LabelTableWidget::LabelTableWidget(QWidget* parent) : QTableWidget(parent) {
   setColumnCount(ColumnCount);
-  setHorizontalHeaderLabels({tr("Label"), tr("Name"), tr("Colour"), tr("Visible"), tr("Opacity"), tr("Surface"),
-                             tr("Roughness")});
+  setHorizontalHeaderLabels(
+      {tr("Label"), tr("Name"), tr("Colour"), tr("Visible"), tr("Opacity"), tr("Surface"), tr("Roughness")});
   verticalHeader()->setVisible(false);
   verticalHeader()->setDefaultSectionSize(24);
   horizontalHeader()->setSectionResizeMode(QHeaderView::Fixed);
   horizontalHeader()->setSectionResizeMode(Name, QHeaderView::Stretch);
-  for (const auto& [column, width] : {std::pair{Id, 40}, {Color, 44}, {Visible, 48}, {Opacity, 58}, {Surface, 58},
-                                      {Roughness, 64}})
+  for (const auto& [column, width] :
+       {std::pair{Id, 40}, {Color, 44}, {Visible, 48}, {Opacity, 58}, {Surface, 58}, {Roughness, 64}})
     setColumnWidth(column, width);
   setSelectionBehavior(QAbstractItemView::SelectRows);
   setEditTriggers(QAbstractItemView::NoEditTriggers);

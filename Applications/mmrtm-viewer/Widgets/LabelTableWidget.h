@@ -15,7 +15,7 @@ struct LabelEntry {
   QString name;
   QColor color;
   bool visible = true;
-  double opacity = 1.0;             // 0..1: the fraction of the label material's density
+  double opacity = 1.0;              // 0..1: the fraction of the label material's density
   double surfaceProbability = 0.75;  // 0: volume scattering only, 1: a surface
   double roughness = 0.45;
 };

@@ -64,8 +64,7 @@ RenderSettingsWidget::RenderSettingsWidget(QWidget* parent) : QWidget(parent) {
     connect(box, &QSpinBox::valueChanged, this, changed);
   for (QDoubleSpinBox* box : {noiseTarget_, shadowScale_, exposure_, lightAzimuth_, lightElevation_, lightIntensity_})
     connect(box, &QDoubleSpinBox::valueChanged, this, changed);
-  for (QComboBox* box : {stop_, accelerator_, backend_})
-    connect(box, &QComboBox::currentIndexChanged, this, changed);
+  for (QComboBox* box : {stop_, accelerator_, backend_}) connect(box, &QComboBox::currentIndexChanged, this, changed);
   connect(environment_, &QCheckBox::toggled, this, changed);
 }
 

@@ -16,9 +16,9 @@ SeriesChooserDialog::SeriesChooserDialog(const QString& folder, const QVector<Se
   list_->setHeaderLabels({tr("Description"), tr("Modality"), tr("Size"), tr("Slices"), tr("Series UID")});
   list_->setRootIsDecorated(false);
   for (const SeriesInfo& s : series)
-    list_->addTopLevelItem(new QTreeWidgetItem(
-        {s.description.isEmpty() ? tr("(no description)") : s.description, s.modality,
-         QString("%1 x %2").arg(s.columns).arg(s.rows), QString::number(s.slices), s.uid}));
+    list_->addTopLevelItem(
+        new QTreeWidgetItem({s.description.isEmpty() ? tr("(no description)") : s.description, s.modality,
+                             QString("%1 x %2").arg(s.columns).arg(s.rows), QString::number(s.slices), s.uid}));
   list_->resizeColumnToContents(0);
   layout->addWidget(list_);
   auto* buttons = new QDialogButtonBox(QDialogButtonBox::Open | QDialogButtonBox::Cancel);

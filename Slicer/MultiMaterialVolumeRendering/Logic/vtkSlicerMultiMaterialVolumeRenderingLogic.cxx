@@ -55,8 +55,8 @@ void vtkSlicerMultiMaterialVolumeRenderingLogic::RegisterNodes()
     scene->RegisterNodeClass(vtkSmartPointer<vtkMRMLMultiMaterialVolumeRenderingDisplayNode>::New());
   if (!this->VolumeRenderingLogic && this->GetMRMLApplicationLogic())
   {
-    this->SetVolumeRenderingLogic(vtkSlicerVolumeRenderingLogic::SafeDownCast(
-      this->GetMRMLApplicationLogic()->GetModuleLogic("VolumeRendering")));
+    this->SetVolumeRenderingLogic(
+      vtkSlicerVolumeRenderingLogic::SafeDownCast(this->GetMRMLApplicationLogic()->GetModuleLogic("VolumeRendering")));
   }
 }
 
@@ -166,8 +166,8 @@ bool vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(
   const char* labelmapName = vtkSegmentationConverter::GetBinaryLabelmapRepresentationName();
   if (!segmentation->ContainsRepresentation(labelmapName) && !segmentationNode->CreateBinaryLabelmapRepresentation())
   {
-    vtkErrorWithObjectMacro(node, "segmentation " << segmentationNode->GetName()
-                                                  << " has no binary labelmap representation and none can be made");
+    vtkErrorWithObjectMacro(node,
+      "segmentation " << segmentationNode->GetName() << " has no binary labelmap representation and none can be made");
     return false;
   }
 
@@ -179,9 +179,9 @@ bool vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(
   if (!vtkMRMLTransformNode::GetMatrixTransformBetweenNodes(
         volume->GetParentTransformNode(), segmentationNode->GetParentTransformNode(), volumeToSegmentation))
   {
-    vtkErrorWithObjectMacro(node, "the transform between volume " << volume->GetName() << " and segmentation "
-                                                                  << segmentationNode->GetName()
-                                                                  << " is not linear: the segments are not rendered");
+    vtkErrorWithObjectMacro(node,
+      "the transform between volume " << volume->GetName() << " and segmentation " << segmentationNode->GetName()
+                                      << " is not linear: the segments are not rendered");
     return false;
   }
   vtkNew<vtkMatrix4x4> gridToSegmentation;
@@ -197,8 +197,9 @@ bool vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(
   if (!segmentationNode->GenerateMergedLabelmap(
         merged, vtkSegmentation::EXTENT_REFERENCE_GEOMETRY, geometry, ids, labels))
   {
-    vtkErrorWithObjectMacro(node, "the segments of " << segmentationNode->GetName()
-                                                     << " could not be merged onto the grid of " << volume->GetName());
+    vtkErrorWithObjectMacro(node,
+      "the segments of " << segmentationNode->GetName() << " could not be merged onto the grid of "
+                         << volume->GetName());
     return false;
   }
   // The label map on the image's own frame: the renderer places both with
@@ -213,8 +214,8 @@ bool vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(
   return true;
 }
 
-int vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(
-  vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkStringArray* segmentIds, vtkMultiMaterialVolumeMapper* mapper)
+int vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
+  vtkStringArray* segmentIds, vtkMultiMaterialVolumeMapper* mapper)
 {
   vtkMRMLSegmentationNode* segmentationNode = node ? node->GetSegmentationNode() : nullptr;
   if (!segmentationNode || !segmentIds || !mapper)
@@ -227,8 +228,8 @@ int vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(
     const std::string id = segmentIds->GetValue(i);
     const int label = static_cast<int>(i) + 1;
     vtkSegment* segment = segmentation->GetSegment(id);
-    const bool shown = segment &&
-      (!display || (display->GetSegmentVisibility(id) && display->GetSegmentVisibility3D(id)));
+    const bool shown =
+      segment && (!display || (display->GetSegmentVisibility(id) && display->GetSegmentVisibility3D(id)));
     if (!shown)
     {
       mapper->RemoveLabelMaterial(label);
@@ -237,7 +238,7 @@ int vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(
     double rgb[3];
     segment->GetColor(rgb);
     if (display)
-      display->GetSegmentColor(id, rgb);  // with the display node's override, if any
+      display->GetSegmentColor(id, rgb); // with the display node's override, if any
     const double opacity3D = display ? display->GetSegmentOpacity3D(id) : 1.0;
     mapper->SetLabelMaterial(label, rgb[0], rgb[1], rgb[2], std::clamp(opacity3D, 0.0, 1.0));
     ++visible;
@@ -246,7 +247,8 @@ int vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentLooks(
 }
 
 void vtkSlicerMultiMaterialVolumeRenderingLogic::ApplySegmentMaterialParameters(
-  vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkStringArray* segmentIds, vtkMultiMaterialVolumeMapper* mapper)
+  vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkStringArray* segmentIds,
+  vtkMultiMaterialVolumeMapper* mapper)
 {
   if (!node || !segmentIds || !mapper)
     return;

@@ -61,14 +61,14 @@ public:
   /// Puts the node's render settings on the mapper: samples per render,
   /// maximum samples, noise target, bounces, shadow extinction scale,
   /// accelerator, backend, seed. Unchanged values change nothing.
-  static void ApplyRenderSettings(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
-    vtkMultiMaterialVolumeMapper* mapper);
+  static void ApplyRenderSettings(
+    vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkMultiMaterialVolumeMapper* mapper);
 
   /// Fills `materials` from the node's MaterialPreset and SceneJSON and
   /// returns true, or returns false when the node has neither (the volume
   /// property is rendered then). A bad preset or JSON is an error naming it.
-  static bool ApplyMaterialDescription(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
-    vtkMultiMaterialProperty* materials);
+  static bool ApplyMaterialDescription(
+    vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkMultiMaterialProperty* materials);
 
   /// The node's segmentation on the grid of its volume's image data (same
   /// extent; origin, spacing and direction as that image: the IJK frame
@@ -76,8 +76,8 @@ public:
   /// `segmentIds` is (the segmentation's order; later segments win where
   /// segments overlap), 0 elsewhere. Returns false, with `labelMap` emptied,
   /// when there is no segmentation, no segment or no volume.
-  static bool ExportSegmentLabelMap(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
-    vtkImageData* labelMap, vtkStringArray* segmentIds);
+  static bool ExportSegmentLabelMap(
+    vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node, vtkImageData* labelMap, vtkStringArray* segmentIds);
 
   /// The segments of `segmentIds` as label materials of `mapper` (label
   /// n + 1 for segment n) by the mapper's one label rule
@@ -92,7 +92,6 @@ public:
   /// The node's segment material parameters on the mapper, by label.
   static void ApplySegmentMaterialParameters(vtkMRMLMultiMaterialVolumeRenderingDisplayNode* node,
     vtkStringArray* segmentIds, vtkMultiMaterialVolumeMapper* mapper);
-
 
 protected:
   vtkSlicerMultiMaterialVolumeRenderingLogic();

@@ -174,7 +174,8 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SetSegmentMaterialParameter
 
 const char* vtkMRMLMultiMaterialVolumeRenderingDisplayNode::GetSegmentMaterialParameters(const char* segmentId)
 {
-  const auto found = segmentId ? this->SegmentMaterialParameters.find(segmentId) : this->SegmentMaterialParameters.end();
+  const auto found =
+    segmentId ? this->SegmentMaterialParameters.find(segmentId) : this->SegmentMaterialParameters.end();
   return found == this->SegmentMaterialParameters.end() ? nullptr : found->second.c_str();
 }
 

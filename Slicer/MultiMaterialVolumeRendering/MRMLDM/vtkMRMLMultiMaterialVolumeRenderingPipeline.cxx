@@ -65,9 +65,9 @@ struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
   vtkNew<vtkImageData> LabelMap;
   vtkNew<vtkStringArray> SegmentIds;
   std::string LabelMapSignature;
-  std::string MaterialDescription = "\n";  // preset and JSON last applied ("\n": none yet)
+  std::string MaterialDescription = "\n"; // preset and JSON last applied ("\n": none yet)
 
-  std::vector<double> ClipPlanes;  // the planes last applied, by value
+  std::vector<double> ClipPlanes; // the planes last applied, by value
   vtkNew<vtkMatrix4x4> Matrix;
 
   vtkWeakPointer<vtkRenderer> Renderer;
@@ -101,7 +101,8 @@ bool vtkMRMLMultiMaterialVolumeRenderingPipeline::RegisterPipelineCreator()
   vtkMRMLLayerDMPipelineFactory::GetInstance()->AddPipelineCreator(
     [](vtkMRMLAbstractViewNode* viewNode, vtkMRMLNode* node) -> vtkSmartPointer<vtkMRMLLayerDMPipeline>
     {
-      if (!vtkMRMLViewNode::SafeDownCast(viewNode) || !vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(node))
+      if (!vtkMRMLViewNode::SafeDownCast(viewNode) ||
+        !vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(node))
         return nullptr;
       auto pipeline = vtkSmartPointer<vtkMRMLMultiMaterialVolumeRenderingPipeline>::New();
       pipeline->SetViewNode(viewNode);
@@ -178,8 +179,8 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateObservedNodes()
   vtkMRMLSegmentationNode* segmentation = node ? node->GetSegmentationNode() : nullptr;
   vtkMRMLNode* segmentationDisplay = segmentation ? segmentation->GetDisplayNode() : nullptr;
 
-  const std::vector<unsigned long> volumeEvents{ vtkCommand::ModifiedEvent,
-    vtkMRMLVolumeNode::ImageDataModifiedEvent, vtkMRMLTransformableNode::TransformModifiedEvent };
+  const std::vector<unsigned long> volumeEvents{ vtkCommand::ModifiedEvent, vtkMRMLVolumeNode::ImageDataModifiedEvent,
+    vtkMRMLTransformableNode::TransformModifiedEvent };
   const std::vector<unsigned long> roiEvents{ vtkCommand::ModifiedEvent, vtkMRMLMarkupsNode::PointModifiedEvent,
     vtkMRMLTransformableNode::TransformModifiedEvent };
   const std::vector<unsigned long> segmentationEvents{ vtkCommand::ModifiedEvent,
@@ -270,8 +271,8 @@ std::string LabelMapSignature(vtkMRMLSegmentationNode* segmentation, vtkMRMLVolu
     s << ';';
   }
   s << volume->GetImageData() << '@' << volume->GetImageData()->GetMTime() << ';' << volume->GetMTime();
-  for (vtkMRMLTransformableNode* node : { static_cast<vtkMRMLTransformableNode*>(volume),
-         static_cast<vtkMRMLTransformableNode*>(segmentation) })
+  for (vtkMRMLTransformableNode* node :
+    { static_cast<vtkMRMLTransformableNode*>(volume), static_cast<vtkMRMLTransformableNode*>(segmentation) })
   {
     vtkMRMLTransformNode* parent = node->GetParentTransformNode();
     s << ';' << parent << '@' << (parent ? parent->GetTransformToWorldMTime() : 0);
@@ -298,7 +299,7 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
       vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(node, in.LabelMap, in.SegmentIds);
       in.LabelMap->Modified();
       in.LabelMapSignature = mapSignature;
-      in.Mapper->RemoveAllLabelMaterials();  // the labels are numbered anew
+      in.Mapper->RemoveAllLabelMaterials(); // the labels are numbered anew
     }
     labels = in.SegmentIds->GetNumberOfValues() > 0;
   }

@@ -74,8 +74,7 @@ struct SurfaceBSDF {
   float metallic = 0.f;
   float alpha = 1.f;
 
-  MMRTM_CPU_GPU static SurfaceBSDF Make(Vec3 gradientNormal, Vec3 wo, RGB baseColor, float roughness,
-                                        float metallic) {
+  MMRTM_CPU_GPU static SurfaceBSDF Make(Vec3 gradientNormal, Vec3 wo, RGB baseColor, float roughness, float metallic) {
     SurfaceBSDF b;
     b.frame = Frame::FromZ(FaceForward(gradientNormal, wo));
     b.baseColor = baseColor;

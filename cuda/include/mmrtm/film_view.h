@@ -14,9 +14,9 @@ namespace mmrtm {
 
 struct FilmView {
   int width = 0, height = 0;
-  float* mean = nullptr;  // 4 floats a pixel: RGB radiance and alpha (coverage)
-  float* m2 = nullptr;    // 3 floats a pixel: sum of squared deviations of RGB
-  float* work = nullptr;  // optional, 1 float a pixel: TraceCounters::Work of its samples
+  float* mean = nullptr;           // 4 floats a pixel: RGB radiance and alpha (coverage)
+  float* m2 = nullptr;             // 3 floats a pixel: sum of squared deviations of RGB
+  float* work = nullptr;           // optional, 1 float a pixel: TraceCounters::Work of its samples
   float* evenLuminance = nullptr;  // required, 1 float a pixel: mean luminance of samples 0, 2, 4 ...
 
   // Adds sample number n (1-based, so sample index n - 1) of pixel (x, y).

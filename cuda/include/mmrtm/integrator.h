@@ -75,7 +75,7 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
   // The probability that NEE samples a given light, for the MIS weights:
   // 1/K when it picks one of K uniformly; 1 when it estimates the sum over
   // all lights (All, and Resampled, which estimates that same sum).
-  float lightSelectPdf = s.lightCount <= 0 ? 0.f
+  float lightSelectPdf = s.lightCount <= 0                     ? 0.f
                          : lightSampling == LightSampling::One ? 1.f / (float)s.lightCount
                                                                : 1.f;
   for (int depth = 0;; ++depth) {
@@ -84,8 +84,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     const int pairBase = kPairFirstVertex + depth * kPairsPerVertex;
     float ldFreePath[2];
     if (ld) ld->Get(pairBase + kPairFreePath, &ldFreePath[0], &ldFreePath[1]);
-    FreePathResult fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr,
-                                       ld ? ldFreePath : nullptr);
+    FreePathResult fp =
+        SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr, ld ? ldFreePath : nullptr);
     if (!fp.collided) {
       if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
@@ -159,8 +159,7 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
         }
         case LightSampling::All:
           for (int li = 0; li < s.lightCount; ++li)
-            if (unshadowed(li, &c))
-              out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr, ldShadow[0]);
+            if (unshadowed(li, &c)) out.L += c * Transmittance(s, Ray{p, ls.wi}, ls.distance, rng, ctr, ldShadow[0]);
           break;
         case LightSampling::Resampled: {
           // One candidate per light, one kept with probability in
@@ -176,7 +175,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
             const float weight = Luminance(c);
             if (!(weight > 0.f)) continue;
             weightSum += weight;
-            const bool keep = ld ? ChooseAndReuse(weight / weightSum, &ldShadow[1]) : rng.Uniform() * weightSum < weight;
+            const bool keep =
+                ld ? ChooseAndReuse(weight / weightSum, &ldShadow[1]) : rng.Uniform() * weightSum < weight;
             if (keep) {
               kept = c;
               keptDir = ls.wi;
@@ -185,8 +185,8 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
             }
           }
           if (keptWeight > 0.f)
-            out.L += kept * (Transmittance(s, Ray{p, keptDir}, keptDistance, rng, ctr, ldShadow[0]) * weightSum /
-                             keptWeight);
+            out.L += kept *
+                     (Transmittance(s, Ray{p, keptDir}, keptDistance, rng, ctr, ldShadow[0]) * weightSum / keptWeight);
           break;
         }
       }

@@ -49,9 +49,7 @@ struct EnvironmentView {
     return Texel(u, v);
   }
   // Solid-angle pdf of sampling the direction of (u, v).
-  MMRTM_CPU_GPU float PdfAtUV(float u, float v) const {
-    return SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi));
-  }
+  MMRTM_CPU_GPU float PdfAtUV(float u, float v) const { return SolidAnglePdf(distribution.Pdf(u, v), sinf(v * kPi)); }
   // Solid-angle pdf of sampling direction w.
   MMRTM_CPU_GPU float Pdf(Vec3 w) const {
     float u, v;
@@ -74,10 +72,10 @@ struct Light {
 };
 
 struct LightSample {
-  Vec3 wi;                // toward the light
+  Vec3 wi;  // toward the light
   float distance = kInfinity;
-  RGB L;                  // incident radiance (delta lights: irradiance)
-  float pdf = 0.f;        // solid-angle pdf; 1 for delta lights
+  RGB L;            // incident radiance (delta lights: irradiance)
+  float pdf = 0.f;  // solid-angle pdf; 1 for delta lights
   bool isDelta = true;
 };
 
@@ -110,7 +108,7 @@ MMRTM_CPU_GPU inline LightSample SampleLight(const Light& light, const Environme
       // lands in the same texel but where float rounding crosses a texel
       // edge, a set of directions of measure zero.
       s.pdf = EnvironmentView::SolidAnglePdf(pdfUV, sinTheta);
-      if (s.pdf <= 0.f) return s;  // pdf 0: no sample
+      if (s.pdf <= 0.f) return s;                                                           // pdf 0: no sample
       MMRTM_DCHECK(env.distribution.nu == env.width && env.distribution.nv == env.height);  // a bucket per texel
       s.L = env.texels[col + env.width * row];
       s.isDelta = false;

@@ -32,8 +32,8 @@ class MajorantIterator {
   }
   // The grid walk is built in place (a copy of its state cost every ray
   // about 55 instructions on the CPU).
-  MMRTM_CPU_GPU static MajorantIterator Grid(const MajorantGridView* grid, GridTraversal traversal,
-                                             const Ray& indexRay, float tMin, float tMax, float scale) {
+  MMRTM_CPU_GPU static MajorantIterator Grid(const MajorantGridView* grid, GridTraversal traversal, const Ray& indexRay,
+                                             float tMin, float tMax, float scale) {
     return MajorantIterator(grid, traversal, indexRay, tMin, tMax, scale);
   }
 
@@ -46,8 +46,8 @@ class MajorantIterator {
   }
 
  private:
-  MMRTM_CPU_GPU MajorantIterator(const MajorantGridView* grid, GridTraversal traversal, const Ray& indexRay,
-                                 float tMin, float tMax, float scale)
+  MMRTM_CPU_GPU MajorantIterator(const MajorantGridView* grid, GridTraversal traversal, const Ray& indexRay, float tMin,
+                                 float tMax, float scale)
       : grid_(grid, traversal, indexRay, tMin, tMax, scale), isGrid_(true) {}
 
   RayMajorantSegment single_;
@@ -66,7 +66,8 @@ struct MajorantSource {
   // majorant (the shadow-ray extinction scale).
   MMRTM_CPU_GPU MajorantIterator Begin(const Ray& indexRay, float tMin, float tMax, float scale) const {
     if (kind == MajorantKind::Global) return MajorantIterator::Single(tMin, tMax, globalMajorant * scale);
-    return MajorantIterator::Grid(&grid, kind == MajorantKind::Macrocell ? GridTraversal::Macrocell : GridTraversal::Octree,
+    return MajorantIterator::Grid(&grid,
+                                  kind == MajorantKind::Macrocell ? GridTraversal::Macrocell : GridTraversal::Octree,
                                   indexRay, tMin, tMax, scale);
   }
 };

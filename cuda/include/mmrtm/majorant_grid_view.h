@@ -40,13 +40,13 @@ enum class GridTraversal : uint8_t {
 };
 
 struct MajorantGridView {
-  int leafLevel = 0;                       // levels 0..leafLevel
-  int cells[3] = {1, 1, 1};                // voxel cells per axis (n - 1, at least 1)
-  int res[kMaxGridLevels][3] = {};         // nodes per axis, per level
-  int nodeSize[kMaxGridLevels] = {};       // node width in voxel cells, per level
-  int64_t offset[kMaxGridLevels] = {};     // first node of each level in `majorants`
-  float worldWidth[kMaxGridLevels] = {};   // node width in world units (largest axis)
-  const float* majorants = nullptr;        // sigma_t bound of every node, level after level
+  int leafLevel = 0;                      // levels 0..leafLevel
+  int cells[3] = {1, 1, 1};               // voxel cells per axis (n - 1, at least 1)
+  int res[kMaxGridLevels][3] = {};        // nodes per axis, per level
+  int nodeSize[kMaxGridLevels] = {};      // node width in voxel cells, per level
+  int64_t offset[kMaxGridLevels] = {};    // first node of each level in `majorants`
+  float worldWidth[kMaxGridLevels] = {};  // node width in world units (largest axis)
+  const float* majorants = nullptr;       // sigma_t bound of every node, level after level
   // A lower bound of sigma_t in every node, indexed as `majorants`, as a
   // fraction of the node's majorant in 255ths (DecodeMinorant): the control
   // of residual ratio tracking (tracking.h). A byte, not a float, so that
@@ -80,8 +80,8 @@ MMRTM_CPU_GPU inline uint8_t EncodeMinorant(float majorant, float minorant) {
 class GridMajorantIterator {
  public:
   GridMajorantIterator() = default;
-  MMRTM_CPU_GPU GridMajorantIterator(const MajorantGridView* grid, GridTraversal traversal, const Ray& r,
-                                     float tMin, float tMax, float scale)
+  MMRTM_CPU_GPU GridMajorantIterator(const MajorantGridView* grid, GridTraversal traversal, const Ray& r, float tMin,
+                                     float tMax, float scale)
       : grid_(grid), o_(r.o), d_(r.d), t_(tMin), tEnd_(tMax), scale_(scale), traversal_(traversal) {
     // Both start at the leaf the ray begins in. For the octree that is where
     // most rays begin (scattered and shadow rays start in matter) and the
@@ -247,7 +247,7 @@ class GridMajorantIterator {
   float t_ = 0.f, tEnd_ = 0.f, scale_ = 1.f;
   int level_ = 0;
   int cell_[3] = {0, 0, 0};
-  int step_[3] = {0, 0, 0};          // +1, -1 or 0: the ray's direction per axis
+  int step_[3] = {0, 0, 0};           // +1, -1 or 0: the ray's direction per axis
   float tClip_[3] = {0.f, 0.f, 0.f};  // where it leaves the grid's last cell ahead (kInfinity: d <= 0)
   float size_ = 1.f;                  // node width of level_, in voxel cells
   int64_t node_ = 0;                  // the index of (level_, cell_)

@@ -40,8 +40,8 @@ enum class Defect : uint8_t {
 
 // The names MMRTM_PLANTED_DEFECT takes, in Defect's order.
 inline const char* DefectName(Defect d) {
-  static const char* const names[] = {"none",         "volume_albedo",  "diffuse_lobe",      "specular_lobe",
-                                      "phase_sign",   "majorant_low",   "minorant_high",     "shadow_last_segment",
+  static const char* const names[] = {"none",          "volume_albedo",   "diffuse_lobe",       "specular_lobe",
+                                      "phase_sign",    "majorant_low",    "minorant_high",      "shadow_last_segment",
                                       "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
                                       "film_variance"};
   static_assert(sizeof(names) / sizeof(names[0]) == (size_t)Defect::Count, "a name per defect");

@@ -14,8 +14,7 @@ struct Ray {
 // Slab test against the box [lo, hi]; on a hit returns the parametric
 // interval clipped to [0, tMax]. The gamma(3) factor of pbrt keeps the far
 // distance conservative under rounding.
-MMRTM_CPU_GPU inline bool IntersectBox(Vec3 o, Vec3 d, Vec3 lo, Vec3 hi, float tMax, float* t0Out,
-                                       float* t1Out) {
+MMRTM_CPU_GPU inline bool IntersectBox(Vec3 o, Vec3 d, Vec3 lo, Vec3 hi, float tMax, float* t0Out, float* t1Out) {
   float t0 = 0.f, t1 = tMax;
   for (int a = 0; a < 3; ++a) {
     float inv = 1.f / d[a];

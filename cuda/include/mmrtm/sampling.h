@@ -54,7 +54,10 @@ struct Distribution1DView {
     int lo = 0, hi = n;  // largest lo with cdf[lo] <= u
     while (hi - lo > 1) {
       int mid = (lo + hi) >> 1;
-      if (cdf[mid] <= u) lo = mid; else hi = mid;
+      if (cdf[mid] <= u)
+        lo = mid;
+      else
+        hi = mid;
     }
     *offset = lo;
     float du = u - cdf[lo];

@@ -35,10 +35,10 @@ enum class PixelSampler : uint8_t {
 
 struct IntegratorSettings {
   Estimator estimator = Estimator::DeltaTracking;
-  int maxBounces = 32;         // real scattering events per path
+  int maxBounces = 32;           // real scattering events per path
   int russianRouletteDepth = 3;  // bounces before Russian roulette starts
   float shadowExtinctionScale = kDefaultShadowExtinctionScale;
-  float rayMarchStep = 0.5f;   // ray marching step, world units
+  float rayMarchStep = 0.5f;      // ray marching step, world units
   bool backgroundVisible = true;  // camera rays that escape see the environment
   LightSampling lightSampling = LightSampling::Resampled;
   PixelSampler sampler = PixelSampler::Sobol;

@@ -83,8 +83,8 @@ MMRTM_CPU_GPU inline uint32_t SobolReplicate(uint32_t sampleIndex) { return samp
 class SobolPairs {
  public:
   MMRTM_CPU_GPU SobolPairs(uint64_t seed, uint64_t pixelIndex, uint32_t sampleIndex)
-      : key_(MixBits(pixelIndex ^ MixBits(seed + 0x5851f42d4c957f2dULL +
-                                          SobolReplicate(sampleIndex) * 0xda942042e4dd58b5ULL))),
+      : key_(MixBits(pixelIndex ^
+                     MixBits(seed + 0x5851f42d4c957f2dULL + SobolReplicate(sampleIndex) * 0xda942042e4dd58b5ULL))),
         reversedIndex_(ReverseBits32(sampleIndex >> 1)) {}
 
   // Pair `pair`, uniform on [0, 1)^2.

@@ -37,7 +37,7 @@ struct FreePathResult {
 // and a violation if the (scaled) extinction there exceeds the majorant that
 // the tracker was given.
 MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, Vec3 index0, float sigma_maj,
-                                                    float scale, TraceCounters& ctr) {
+                                                   float scale, TraceCounters& ctr) {
   Classification c = s.classifier.Classify(p, index0);
   ++ctr.densityLookups;
   if (scale * c.sigma_t > sigma_maj * 1.0001f) ++ctr.majorantViolations;
@@ -65,8 +65,8 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, V
 // residual segment), whose sigma_maj is that rate.
 template <bool Residual = false, typename Visit, typename Segment>
 MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
-                                                    PCG32& rng, TraceCounters& ctr, Visit visit,
-                                                    Segment segment, float uFirst = -1.f) {
+                                                    PCG32& rng, TraceCounters& ctr, Visit visit, Segment segment,
+                                                    float uFirst = -1.f) {
   Ray indexRay;
   float t0, t1;
   if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
@@ -109,19 +109,22 @@ MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ra
                                                TraceCounters& ctr, const float* first = nullptr) {
   FreePathResult r;
   bool firstChoice = first != nullptr;
-  SampleTentativeCollisions(s, ray, tMax, 1.f, rng, ctr, [&](float t, const Classification& c, float sigma_maj) {
-    const float u = firstChoice ? first[1] : rng.Uniform();
-    firstChoice = false;
-    if (u * sigma_maj < c.sigma_t) {
-      ++ctr.realCollisions;
-      r.collided = true;
-      r.t = t;
-      r.c = c;
-      return false;
-    }
-    ++ctr.nullCollisions;
-    return true;
-  }, [](const RayMajorantSegment&) { return true; }, first ? first[0] : -1.f);
+  SampleTentativeCollisions(
+      s, ray, tMax, 1.f, rng, ctr,
+      [&](float t, const Classification& c, float sigma_maj) {
+        const float u = firstChoice ? first[1] : rng.Uniform();
+        firstChoice = false;
+        if (u * sigma_maj < c.sigma_t) {
+          ++ctr.realCollisions;
+          r.collided = true;
+          r.t = t;
+          r.c = c;
+          return false;
+        }
+        ++ctr.nullCollisions;
+        return true;
+      },
+      [](const RayMajorantSegment&) { return true; }, first ? first[0] : -1.f);
   return r;
 }
 
@@ -210,8 +213,8 @@ MMRTM_CPU_GPU inline FreePathResult SampleFreePath(const SceneView& s, const Ray
                                                         : DeltaTrack(s, ray, tMax, rng, ctr, first);
 }
 
-MMRTM_CPU_GPU inline float Transmittance(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
-                                         TraceCounters& ctr, float uFirst = -1.f) {
+MMRTM_CPU_GPU inline float Transmittance(const SceneView& s, const Ray& ray, float tMax, PCG32& rng, TraceCounters& ctr,
+                                         float uFirst = -1.f) {
   float scale = s.settings.shadowExtinctionScale;
   return s.settings.estimator == Estimator::RayMarching ? RayMarchTransmittance(s, ray, tMax, scale, rng, ctr)
                                                         : RatioTrack(s, ray, tMax, scale, rng, ctr, uFirst);

@@ -37,8 +37,8 @@ struct TransferFunctionView {
   // CCTF, CDPTF, MDPTF: count keys, ascending.
   // CPCTF, MPCTF: count [lo, hi) pairs, 2*count floats, in priority order.
   const float* keys = nullptr;
-  const float* values = nullptr;    // coefficient TFs: count*channels
-  const int* materials = nullptr;   // material TFs: count material indices
+  const float* values = nullptr;   // coefficient TFs: count*channels
+  const int* materials = nullptr;  // material TFs: count material indices
   // Discrete TFs: entry index by round(x) - denseMin, -1 for none, when the
   // keys span a small integer range (labels); otherwise a binary search.
   const int* denseIndex = nullptr;
@@ -63,7 +63,10 @@ struct TransferFunctionView {
       while (lo <= hi) {
         int mid = (lo + hi) >> 1;
         if (keys[mid] == r) return mid;
-        if (keys[mid] < r) lo = mid + 1; else hi = mid - 1;
+        if (keys[mid] < r)
+          lo = mid + 1;
+        else
+          hi = mid - 1;
       }
       return -1;
     }
@@ -84,18 +87,22 @@ struct TransferFunctionView {
         // Evenly spaced keys (to within a quarter step, Scene::Build checks):
         // the estimate is the segment or one of its neighbours.
         lo = (int)f;
-        if (keys[lo] > x) --lo;
-        else if (keys[lo + 1] <= x) ++lo;
+        if (keys[lo] > x)
+          --lo;
+        else if (keys[lo + 1] <= x)
+          ++lo;
         hi = lo + 1;
       } else {
         while (hi - lo > 1) {
           int mid = (lo + hi) >> 1;
-          if (keys[mid] <= x) lo = mid; else hi = mid;
+          if (keys[mid] <= x)
+            lo = mid;
+          else
+            hi = mid;
         }
       }
       float t = (x - keys[lo]) / (keys[hi] - keys[lo]);
-      for (int c = 0; c < channels; ++c)
-        out[c] = Lerp(t, values[lo * channels + c], values[hi * channels + c]);
+      for (int c = 0; c < channels; ++c) out[c] = Lerp(t, values[lo * channels + c], values[hi * channels + c]);
       return;
     }
     int i = FindEntry(x);
@@ -145,7 +152,10 @@ struct TransferFunctionView {
     }
     for (int i = 0; i < count; ++i) {
       if (!EntryInRange(i, lo, hi)) continue;
-      if (first) Copy(i, out); else AccumulateMin(values + i * channels, out);
+      if (first)
+        Copy(i, out);
+      else
+        AccumulateMin(values + i * channels, out);
       first = false;
     }
     if (first)

@@ -18,8 +18,16 @@ struct Vec3 {
   MMRTM_CPU_GPU Vec3 operator-(Vec3 b) const { return {x - b.x, y - b.y, z - b.z}; }
   MMRTM_CPU_GPU Vec3 operator-() const { return {-x, -y, -z}; }
   MMRTM_CPU_GPU Vec3 operator*(float s) const { return {x * s, y * s, z * s}; }
-  MMRTM_CPU_GPU Vec3 operator/(float s) const { float r = 1.f / s; return {x * r, y * r, z * r}; }
-  MMRTM_CPU_GPU Vec3& operator+=(Vec3 b) { x += b.x; y += b.y; z += b.z; return *this; }
+  MMRTM_CPU_GPU Vec3 operator/(float s) const {
+    float r = 1.f / s;
+    return {x * r, y * r, z * r};
+  }
+  MMRTM_CPU_GPU Vec3& operator+=(Vec3 b) {
+    x += b.x;
+    y += b.y;
+    z += b.z;
+    return *this;
+  }
 };
 
 MMRTM_CPU_GPU inline Vec3 operator*(float s, Vec3 v) { return v * s; }
@@ -46,10 +54,28 @@ struct RGB {
   MMRTM_CPU_GPU RGB operator-(RGB o) const { return {r - o.r, g - o.g, b - o.b}; }
   MMRTM_CPU_GPU RGB operator*(RGB o) const { return {r * o.r, g * o.g, b * o.b}; }
   MMRTM_CPU_GPU RGB operator*(float s) const { return {r * s, g * s, b * s}; }
-  MMRTM_CPU_GPU RGB operator/(float s) const { float i = 1.f / s; return {r * i, g * i, b * i}; }
-  MMRTM_CPU_GPU RGB& operator+=(RGB o) { r += o.r; g += o.g; b += o.b; return *this; }
-  MMRTM_CPU_GPU RGB& operator*=(RGB o) { r *= o.r; g *= o.g; b *= o.b; return *this; }
-  MMRTM_CPU_GPU RGB& operator*=(float s) { r *= s; g *= s; b *= s; return *this; }
+  MMRTM_CPU_GPU RGB operator/(float s) const {
+    float i = 1.f / s;
+    return {r * i, g * i, b * i};
+  }
+  MMRTM_CPU_GPU RGB& operator+=(RGB o) {
+    r += o.r;
+    g += o.g;
+    b += o.b;
+    return *this;
+  }
+  MMRTM_CPU_GPU RGB& operator*=(RGB o) {
+    r *= o.r;
+    g *= o.g;
+    b *= o.b;
+    return *this;
+  }
+  MMRTM_CPU_GPU RGB& operator*=(float s) {
+    r *= s;
+    g *= s;
+    b *= s;
+    return *this;
+  }
 
   MMRTM_CPU_GPU float MaxComponent() const { return Max(r, Max(g, b)); }
   MMRTM_CPU_GPU bool IsBlack() const { return r == 0.f && g == 0.f && b == 0.f; }
@@ -82,7 +108,7 @@ struct Affine3 {
 };
 
 // Host-only helpers for building transforms.
-Affine3 AffineInverse(const Affine3& a);  // throws std::runtime_error if singular
+Affine3 AffineInverse(const Affine3& a);                            // throws std::runtime_error if singular
 Affine3 AffineCompose(const Affine3& outer, const Affine3& inner);  // outer(inner(p))
 
 // Orthonormal frame around a unit normal (Duff et al. 2017).

@@ -25,7 +25,7 @@ struct VolumeView {
   VoxelType type = VoxelType::UInt8;
   Interpolation interpolation = Interpolation::Trilinear;
   int nx = 0, ny = 0, nz = 0;  // set with SetExtent, which derives the rest
-  Affine3 worldToIndex;  // world point -> continuous voxel index
+  Affine3 worldToIndex;        // world point -> continuous voxel index
   // Derived from the extent, so that a lookup does not recompute them: the
   // domain's far corner n - 1 per axis; the largest first corner of a
   // trilinear cell (n - 2, or 0 on a flat axis of one voxel); the index
@@ -62,10 +62,14 @@ struct VolumeView {
   MMRTM_CPU_GPU float Voxel(int x, int y, int z) const {
     int64_t o = Offset(x, y, z);
     switch (type) {
-      case VoxelType::UInt8: return (float)static_cast<const uint8_t*>(data)[o];
-      case VoxelType::Int16: return (float)static_cast<const int16_t*>(data)[o];
-      case VoxelType::UInt16: return (float)static_cast<const uint16_t*>(data)[o];
-      default: return static_cast<const float*>(data)[o];
+      case VoxelType::UInt8:
+        return (float)static_cast<const uint8_t*>(data)[o];
+      case VoxelType::Int16:
+        return (float)static_cast<const int16_t*>(data)[o];
+      case VoxelType::UInt16:
+        return (float)static_cast<const uint16_t*>(data)[o];
+      default:
+        return static_cast<const float*>(data)[o];
     }
   }
 
@@ -74,10 +78,14 @@ struct VolumeView {
     if (interpolation == Interpolation::Nearest)
       return Voxel(NearestIndex(p.x, nx), NearestIndex(p.y, ny), NearestIndex(p.z, nz));
     switch (type) {
-      case VoxelType::UInt8: return Trilinear(static_cast<const uint8_t*>(data), p);
-      case VoxelType::Int16: return Trilinear(static_cast<const int16_t*>(data), p);
-      case VoxelType::UInt16: return Trilinear(static_cast<const uint16_t*>(data), p);
-      default: return Trilinear(static_cast<const float*>(data), p);
+      case VoxelType::UInt8:
+        return Trilinear(static_cast<const uint8_t*>(data), p);
+      case VoxelType::Int16:
+        return Trilinear(static_cast<const int16_t*>(data), p);
+      case VoxelType::UInt16:
+        return Trilinear(static_cast<const uint16_t*>(data), p);
+      default:
+        return Trilinear(static_cast<const float*>(data), p);
     }
   }
 
@@ -100,10 +108,14 @@ struct VolumeView {
   MMRTM_CPU_GPU Vec3 CentralDifferences(Vec3 p) const {
     if (interpolation == Interpolation::Trilinear && NeighbourCellsAreExact(p)) {
       switch (type) {
-        case VoxelType::UInt8: return NeighbourDifferences(static_cast<const uint8_t*>(data), p);
-        case VoxelType::Int16: return NeighbourDifferences(static_cast<const int16_t*>(data), p);
-        case VoxelType::UInt16: return NeighbourDifferences(static_cast<const uint16_t*>(data), p);
-        default: return NeighbourDifferences(static_cast<const float*>(data), p);
+        case VoxelType::UInt8:
+          return NeighbourDifferences(static_cast<const uint8_t*>(data), p);
+        case VoxelType::Int16:
+          return NeighbourDifferences(static_cast<const int16_t*>(data), p);
+        case VoxelType::UInt16:
+          return NeighbourDifferences(static_cast<const uint16_t*>(data), p);
+        default:
+          return NeighbourDifferences(static_cast<const float*>(data), p);
       }
     }
     return CentralDifferencesBySixLookups(p);
@@ -133,10 +145,8 @@ struct VolumeView {
     // Clamped to the domain as Min(Max()), which compiles to two
     // instructions (and takes NaN to 0); then the cell's first corner, which
     // is at least 0 and at most lastCell.
-    const float fx = Min(Max(p.x, 0.f), last[0]), fy = Min(Max(p.y, 0.f), last[1]),
-                fz = Min(Max(p.z, 0.f), last[2]);
-    const int x0 = MinInt((int)fx, lastCell[0]), y0 = MinInt((int)fy, lastCell[1]),
-              z0 = MinInt((int)fz, lastCell[2]);
+    const float fx = Min(Max(p.x, 0.f), last[0]), fy = Min(Max(p.y, 0.f), last[1]), fz = Min(Max(p.z, 0.f), last[2]);
+    const int x0 = MinInt((int)fx, lastCell[0]), y0 = MinInt((int)fy, lastCell[1]), z0 = MinInt((int)fz, lastCell[2]);
     return InCell(v + Offset(x0, y0, z0), fx - x0, fy - y0, fz - z0);
   }
 
