@@ -16,20 +16,16 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from slicer_test_scene import DATA, SlicerScene  # noqa: E402
+from slicer_test_scene import SlicerScene  # noqa: E402
 
 SIZE = int(os.environ.get("BENCH_SIZE", "96"))
-REPEATS = int(os.environ.get("BENCH_REPEATS", "9"))
+REPEATS = int(os.environ.get("BENCH_REPEATS", "15"))
 
 
 def main():
     s = SlicerScene()
     view = s.add_view(size=SIZE)
-    ct = s.load_volume(os.path.join(DATA, "ct_abdomen.nii.gz"), "abdomen")
-    labels = s.load_volume(os.path.join(DATA, "ct_abdomen_labels.nii.gz"), "labels", labelmap=True)
-    segmentation = s.scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "organs")
-    segmentation.CreateDefaultDisplayNodes()
-    assert s.segmentations.ImportLabelmapToSegmentationNode(labels, segmentation)
+    ct, segmentation = s.load_abdomen_with_segments()
     display = s.show_with_path_tracing(ct, preset="CT-Soft-Tissue", samples_per_render=1, maximum_samples=0)
     display.SetAndObserveSegmentationNodeID(segmentation.GetID())
     view.look_at_volume()

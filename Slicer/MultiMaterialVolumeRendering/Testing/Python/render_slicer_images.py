@@ -58,11 +58,7 @@ def head(out):
 def abdomen(out):
     s = SlicerScene()
     view = s.add_view(size=SIZE)
-    ct = s.load_volume(os.path.join(DATA, "ct_abdomen.nii.gz"), "abdomen")
-    labels = s.load_volume(os.path.join(DATA, "ct_abdomen_labels.nii.gz"), "labels", labelmap=True)
-    segmentation = s.scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "organs")
-    segmentation.CreateDefaultDisplayNodes()
-    s.segmentations.ImportLabelmapToSegmentationNode(labels, segmentation)
+    ct, segmentation = s.load_abdomen_with_segments()
     display = s.show_with_path_tracing(ct, preset="CT-Bone", samples_per_render=16, maximum_samples=SAMPLES)
     display.SetAndObserveSegmentationNodeID(segmentation.GetID())
     view.look_at_volume(azimuth=-30, elevation=10)

@@ -78,6 +78,17 @@ class SlicerScene:
         assert node is not None, "Slicer's volumes logic could not read " + path
         return node
 
+    def load_abdomen_with_segments(self):
+        """ct_abdomen and its 61-label map (TotalSegmentator) imported as a
+        segmentation, as a user imports a label map in Segmentations.
+        Returns the CT's volume node and the segmentation node."""
+        ct = self.load_volume(os.path.join(DATA, "ct_abdomen.nii.gz"), "abdomen")
+        labels = self.load_volume(os.path.join(DATA, "ct_abdomen_labels.nii.gz"), "labels", labelmap=True)
+        segmentation = self.scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "organs")
+        segmentation.CreateDefaultDisplayNodes()
+        assert self.segmentations.ImportLabelmapToSegmentationNode(labels, segmentation), "the label map imports"
+        return ct, segmentation
+
     def load_dicom_series(self, folder, name):
         """A DICOM series as Slicer's DICOM module loads it
         (DICOMScalarVolumePlugin): the files sorted along the slice normal by

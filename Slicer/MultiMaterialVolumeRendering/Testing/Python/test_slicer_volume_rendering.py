@@ -223,11 +223,7 @@ class SegmentationTest(unittest.TestCase):
     def setUp(self):
         s = self.s = SlicerScene()
         self.view = s.add_view()
-        self.ct = s.load_volume(os.path.join(DATA, "ct_abdomen.nii.gz"), "abdomen")
-        labels = s.load_volume(os.path.join(DATA, "ct_abdomen_labels.nii.gz"), "labels", labelmap=True)
-        self.segmentation = s.scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "organs")
-        self.segmentation.CreateDefaultDisplayNodes()
-        self.assertTrue(s.segmentations.ImportLabelmapToSegmentationNode(labels, self.segmentation))
+        self.ct, self.segmentation = s.load_abdomen_with_segments()
         segments = self.segmentation.GetSegmentation()
         self.assertEqual(segments.GetNumberOfSegments(), 61)
         self.liver = [segments.GetNthSegmentID(i) for i in range(61)
