@@ -17,7 +17,9 @@
 // must do the work its kind of edit needs and no more (Work: counted by the
 // mapper's scene builds, translations, restarts, and the majorant grid's
 // builds and refits): the exposure and an unchanged render none, a camera
-// or settings edit a restart without a refit.
+// or settings edit a restart without a refit, a colour or shading edit a
+// translation without a refit (the majorants bound extinction only), an
+// opacity edit a translation and a refit.
 //
 //   TestMapperEdits [-D DATA_DIR] [CASE...]     (no CASE: all of them)
 //
@@ -83,7 +85,8 @@ enum class Work
 {
   Display,     // none: the accumulation goes on (the exposure, no change at all)
   Restart,     // the accumulation restarts; nothing translated, no refit
-  Refit,       // the property translated again (the majorants refitted if they read what changed)
+  Translate,   // the property translated again; the majorants kept (what changed is not extinction)
+  Refit,       // the property translated again and the majorants refitted (extinction changed)
   Rebuild,     // the proxies and the grid's summaries built again
   Accelerator, // a restart; the grid built or refitted for the new accelerator
 };
@@ -119,8 +122,10 @@ bool WorkAsExpected(Work w, const Counts& d)
       return d.builds == 0 && d.translations == 0 && d.restarts == 0 && d.gridBuilds == 0 && d.gridRefits == 0;
     case Work::Restart:
       return d.builds == 0 && d.translations == 0 && d.restarts == 1 && d.gridBuilds == 0 && d.gridRefits == 0;
+    case Work::Translate:
+      return d.builds == 0 && d.translations == 1 && d.restarts == 1 && d.gridBuilds == 0 && d.gridRefits == 0;
     case Work::Refit:
-      return d.builds == 0 && d.translations == 1 && d.restarts == 1 && d.gridBuilds == 0 && d.gridRefits <= 1;
+      return d.builds == 0 && d.translations == 1 && d.restarts == 1 && d.gridBuilds == 0 && d.gridRefits == 1;
     case Work::Rebuild:
       return d.builds == 1 && d.translations == 1 && d.restarts == 1 && d.gridBuilds == 1 && d.gridRefits == 1;
     case Work::Accelerator:
@@ -137,8 +142,10 @@ const char* WorkName(Work w)
       return "display only";
     case Work::Restart:
       return "a restart";
-    case Work::Refit:
+    case Work::Translate:
       return "a translation and restart";
+    case Work::Refit:
+      return "a translation, refit and restart";
     case Work::Rebuild:
       return "a rebuild";
     case Work::Accelerator:
@@ -517,7 +524,7 @@ std::vector<Case> Cases()
   c.push_back({ "nothing", Input::Head, HeadFunctions, [](Objects&) {}, false, Work::Display });
 
   // The work of the edits that do not only translate the property again.
-  const std::map<std::string, Work> work = { { "gradient-opacity-enabled", Work::Rebuild },
+  std::map<std::string, Work> work = { { "gradient-opacity-enabled", Work::Rebuild },
     { "gradient-opacity-disabled", Work::Rebuild }, { "independent-components-off", Work::Rebuild },
     { "independent-components-on", Work::Rebuild }, { "component-gradient-opacity", Work::Rebuild },
     { "label-gradient-opacity", Work::Rebuild }, { "mask-binary", Work::Rebuild }, { "seed", Work::Restart },
@@ -526,6 +533,12 @@ std::vector<Case> Cases()
     { "environment-texture", Work::Restart }, { "environment-intensity", Work::Restart },
     { "environment-texels", Work::Restart }, { "clipping-plane", Work::Restart },
     { "clipping-plane-moved", Work::Restart }, { "cropping", Work::Restart } };
+  // Edits of what is not extinction (colours, shading, surfaces) keep the majorants.
+  for (const char* name : { "color-rgb-point", "color-rgb-to-gray", "color-gray-point", "shade-on", "shade-off",
+         "ambient", "diffuse", "specular", "specular-power", "interpolation-nearest", "transfer-function-2d",
+         "component-color-point", "label-color-point", "label-color-replaced", "label-material",
+         "label-material-edited", "label-material-removed", "label-look-colour" })
+    work[name] = Work::Translate;
   for (Case& x : c)
     if (auto it = work.find(x.name); it != work.end())
       x.work = it->second;

@@ -63,26 +63,32 @@ class CudaBackend : public Renderer {
   }
 
  private:
-  // Uploads the view (every call: the caller renders after a change; the
-  // voxels only the first time), refits, and runs `onDevice`; a scene too
-  // large for the device goes to `onCpu` with a CPU backend instead.
+  // Uploads what changed in the view since the last call (nothing for an
+  // unchanged scene or a camera move: the camera and settings travel with
+  // each launch), refits on the device after new majorants, and runs
+  // `onDevice`; a scene too large for the device goes to `onCpu` with a CPU
+  // backend instead.
   template <typename OnDevice, typename OnCpu>
   bool Run(const Scene& scene, const SceneView& view, const OnDevice& onDevice, const OnCpu& onCpu) {
     if (fallback_) return onCpu(*fallback_);
     try {
-      gpu_.SetScene(view, first_);
+      const SceneUploads uploads = uploads_.Plan(scene, view);
+      gpu_.SetScene(view, uploads);
       const MajorantGrid* grid = scene.Grid();
-      if (grid && view.majorants.kind != MajorantKind::Global &&
+      if (uploads.majorants && grid && view.majorants.kind != MajorantKind::Global &&
           scene.render.accelerator.grid.summary == SummaryMode::CellRanges)
-        gpu_.Refit(*grid, view.classifier, first_);
-      first_ = false;
+        gpu_.Refit(*grid, view.classifier, uploads.summaries);
       onDevice();
       return true;
     } catch (const DeviceMemoryError& e) {
+      uploads_.Forget();
       if (fallbackThreads_ < 0) throw;
       if (note_) note_(std::string(e.what()) + "; rendering on the CPU instead");
       fallback_ = std::make_unique<CpuBackend>(fallbackThreads_);
       return onCpu(*fallback_);
+    } catch (...) {
+      uploads_.Forget();
+      throw;
     }
   }
 
@@ -90,7 +96,7 @@ class CudaBackend : public Renderer {
   int fallbackThreads_;
   std::function<void(const std::string&)> note_;
   std::unique_ptr<CpuBackend> fallback_;
-  bool first_ = true;
+  SceneUploadPlanner uploads_;
 };
 #endif
 

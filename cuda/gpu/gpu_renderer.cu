@@ -75,11 +75,14 @@ int Blocks(int64_t n, int threads) { return (int)((n + threads - 1) / threads); 
 struct GpuRenderer::Impl {
   SceneView device;  // the uploaded scene
   bool hasScene = false;
-  // Voxels by (host address, bytes): kept across SetScene without dataChanged.
+  // Voxels by (host address, bytes): kept across SetScene until uploads.voxels.
   std::map<std::pair<const void*, size_t>, DeviceBuffer> voxels;
-  std::vector<DeviceBuffer> tables;  // everything else, replaced on every SetScene
-  float* majorants = nullptr;        // inside `tables`
-  uint8_t* minorants = nullptr;      // inside `tables`, as many
+  // Everything else, by part (tables, grid, environment), in the order
+  // RelocateSceneView visits it: a part not uploaded keeps its buffers.
+  enum Part { kTables, kGrid, kEnvironment, kParts };
+  std::vector<DeviceBuffer> parts[kParts];
+  float* majorants = nullptr;    // inside parts[kGrid]
+  uint8_t* minorants = nullptr;  // inside parts[kGrid], as many
   size_t majorantCount = 0;
   DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, summaryLowerBounds, binMax, binMaterials, binMin,
       uncoveredBins;
@@ -162,9 +165,11 @@ GpuRenderer::GpuRenderer() : impl_(new Impl) {
 
 GpuRenderer::~GpuRenderer() = default;
 
-void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
+void GpuRenderer::SetScene(const SceneView& view, const SceneUploads& uploads) {
   Impl& m = *impl_;
-  if (dataChanged) m.voxels.clear();
+  if (uploads.voxels) m.voxels.clear();
+  const bool upload[Impl::kParts] = {uploads.tables || !m.hasScene, uploads.majorants || !m.hasScene,
+                                     uploads.environment || !m.hasScene};
   // Memory check before any allocation: what is not already on the device.
   const SceneFootprint footprint = MeasureSceneView(view);
   size_t kept = 0;
@@ -173,6 +178,9 @@ void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
     auto it = m.voxels.find({v.data, (size_t)v.nx * v.ny * v.nz * VoxelTypeSize(v.type)});
     if (it != m.voxels.end()) kept += it->second.Bytes();
   }
+  if (!upload[Impl::kTables]) kept += footprint.tables;
+  if (!upload[Impl::kGrid]) kept += footprint.majorants + footprint.minorants;
+  if (!upload[Impl::kEnvironment]) kept += footprint.environment;
   size_t freeBytes = 0, totalBytes = 0;
   MMRTM_CUDA_CHECK(cudaMemGetInfo(&freeBytes, &totalBytes));
   const size_t needed = footprint.Total() - kept;
@@ -184,7 +192,7 @@ void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
                             " tables and environment), " + DeviceBuffer::Megabytes(freeBytes) + " free of " +
                             DeviceBuffer::Megabytes(totalBytes));
 
-  std::vector<DeviceBuffer> tables;
+  std::vector<DeviceBuffer> parts[Impl::kParts];
   std::map<std::pair<const void*, size_t>, DeviceBuffer> voxels;
   float* majorants = nullptr;
   uint8_t* minorants = nullptr;
@@ -199,14 +207,21 @@ void GpuRenderer::SetScene(const SceneView& view, bool dataChanged) {
       return b.Get();
     }
     const bool grid = kind == SceneArrayKind::Majorants || kind == SceneArrayKind::Minorants;
-    tables.emplace_back(bytes, grid ? "majorants" : "scene tables");
-    tables.back().Upload(host, bytes);
-    if (kind == SceneArrayKind::Majorants) majorants = tables.back().As<float>();
-    if (kind == SceneArrayKind::Minorants) minorants = tables.back().As<uint8_t>();
-    return tables.back().Get();
+    const int part = grid ? Impl::kGrid : kind == SceneArrayKind::Environment ? Impl::kEnvironment : Impl::kTables;
+    std::vector<DeviceBuffer>& previous = m.parts[part];
+    const size_t index = parts[part].size();
+    if (!upload[part] && index < previous.size() && previous[index].Bytes() == bytes) {
+      parts[part].push_back(std::move(previous[index]));
+    } else {
+      parts[part].emplace_back(bytes, grid ? "majorants" : part == Impl::kEnvironment ? "environment" : "scene tables");
+      parts[part].back().Upload(host, bytes);
+    }
+    if (kind == SceneArrayKind::Majorants) majorants = parts[part].back().As<float>();
+    if (kind == SceneArrayKind::Minorants) minorants = parts[part].back().As<uint8_t>();
+    return parts[part].back().Get();
   });
   m.voxels = std::move(voxels);
-  m.tables = std::move(tables);
+  for (int part = 0; part < Impl::kParts; ++part) m.parts[part] = std::move(parts[part]);
   m.majorants = majorants;
   m.minorants = minorants;
   m.majorantCount = footprint.majorants / sizeof(float);

@@ -16,6 +16,7 @@
 #include "majorant_grid.h"
 #include "mmrtm/counters.h"
 #include "mmrtm/scene_view.h"
+#include "scene_uploads.h"
 
 namespace mmrtm {
 
@@ -27,17 +28,19 @@ class GpuRenderer {
   GpuRenderer(const GpuRenderer&) = delete;
   GpuRenderer& operator=(const GpuRenderer&) = delete;
 
-  // Uploads the scene. The voxels go up only with `dataChanged` (or when a
-  // proxy's address or size changed); TFs, materials, lights, environment
-  // and majorants are small and go up on every call, which the caller makes
-  // only when something changed. Checks the free device memory first and
-  // throws DeviceMemoryError with the sizes when it is short.
-  void SetScene(const SceneView& view, bool dataChanged);
+  // Uploads the parts of the scene that `uploads` asks for (a
+  // SceneUploadPlanner's answer; everything by default); the others keep
+  // the device copies of the last call, which must have the same sizes.
+  // Voxels go up also when a proxy's address or size changed. Checks the
+  // free device memory first and throws DeviceMemoryError with the sizes
+  // when it is short.
+  void SetScene(const SceneView& view, const SceneUploads& uploads = SceneUploads());
 
   // Refits the uploaded scene's majorant grid on the device: the leaves in
   // parallel, then each upper level. `grid` is the host grid the scene was
   // built with (its summaries go up when `summariesChanged`), `classifier`
-  // the host classifier (its TFs give the per-bin tables).
+  // the host classifier (its TFs give the per-bin tables). The caller
+  // refits only after uploading the majorants (SceneUploads::majorants).
   void Refit(const MajorantGrid& grid, const Classifier& classifier, bool summariesChanged);
   // The device majorants, level after level, and the minorant bytes (for tests).
   std::vector<float> DownloadMajorants() const;

@@ -1,6 +1,7 @@
 #include "scene.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -55,6 +56,12 @@ class RefitKey {
   std::vector<uint8_t> bytes_;
 };
 
+// The next stamp of the process-wide build clock (never 0).
+uint64_t NextBuildStamp() {
+  static std::atomic<uint64_t> clock{0};
+  return ++clock;
+}
+
 }  // namespace
 
 std::vector<uint8_t> Scene::MakeRefitKey() const {
@@ -69,8 +76,18 @@ std::vector<uint8_t> Scene::MakeRefitKey() const {
     for (const auto& row : v.indexToWorld.m)
       for (float x : row) k.Add(x);
   }
+  // Of the classification, the refit reads what gives sigma_t: the
+  // materials' base densities and density TFs, and the material TFs. A
+  // colour, surface or emission edit leaves the majorants as they are.
+  std::vector<char> read(tfs.size(), 0);
+  for (const MaterialDesc& m : materials)
+    for (const MaterialDesc::Binding& b : m.bindings)
+      if (b.quantity == Quantity::Density && b.tf >= 0 && b.tf < (int)tfs.size()) read[(size_t)b.tf] = 1;
   k.Add(tfs.size());
-  for (const TransferFunctionDesc& tf : tfs) {
+  for (size_t i = 0; i < tfs.size(); ++i) {
+    const TransferFunctionDesc& tf = tfs[i];
+    k.Add(read[i] || IsMaterialTF(tf.type));
+    if (!read[i] && !IsMaterialTF(tf.type)) continue;
     k.Add(tf.type);
     k.Add(tf.proxy);
     k.Add(tf.channels);
@@ -80,12 +97,10 @@ std::vector<uint8_t> Scene::MakeRefitKey() const {
   }
   k.Add(materials.size());
   for (const MaterialDesc& m : materials) {
-    for (float x : m.base) k.Add(x);
-    k.Add(m.bindings.size());
-    for (const MaterialDesc::Binding& b : m.bindings) {
-      k.Add(b.tf);
-      k.Add(b.quantity);
-    }
+    k.Add(m.base[0]);
+    for (const MaterialDesc::Binding& b : m.bindings)
+      if (b.quantity == Quantity::Density) k.Add(b.tf);
+    k.Add(-1);  // the end of this material's density bindings
   }
   k.AddAll(selectors);
   k.Add(defaultMaterial);
@@ -251,6 +266,8 @@ bool Scene::AdoptDataSummariesFrom(Scene& previous) {
   grid_ = std::move(previous.grid_);
   valueRanges_ = previous.valueRanges_;
   summarisedVoxels_ = previous.summarisedVoxels_;
+  stamps_.voxels = previous.stamps_.voxels;
+  stamps_.summaries = previous.stamps_.summaries;
   dataModified_ = false;
   return true;
 }
@@ -268,6 +285,7 @@ SceneView Scene::Build() {
       valueRanges_.push_back(v.ValueRange());
       summarisedVoxels_.push_back(v.voxels.data());
     }
+    stamps_.voxels = NextBuildStamp();
   }
 
   // Flatten the TFs: offsets first (the pools must not reallocate under the views).
@@ -388,9 +406,11 @@ SceneView Scene::Build() {
     }
     std::vector<uint8_t> key = MakeRefitKey();
     gridRefitted_ = gridBuilt_ || !modifiedRegions_.empty() || key != refitKey_;
+    if (gridBuilt_ || !modifiedRegions_.empty()) stamps_.summaries = NextBuildStamp();
     if (gridRefitted_) {
       grid_->Refit(c);
       refitKey_ = std::move(key);
+      stamps_.majorants = NextBuildStamp();
     }
     s.majorants.grid = grid_->View();
   }

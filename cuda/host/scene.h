@@ -133,18 +133,30 @@ class Scene {
   // Whether the last Build built the grid's summaries (not only a refit).
   bool GridSummariesBuiltByLastBuild() const { return gridBuilt_; }
   // Whether the last Build refitted the grid's majorants. It does only when
-  // something a refit reads changed since the last refit (the TFs, the
-  // materials, the selectors, the proxies' buffers and geometry, the
-  // accelerator) or the summaries were built: an unchanged Build, or one
-  // after a camera or settings change, keeps the majorants it has.
+  // something a refit reads changed since the last refit (the density and
+  // material TFs, the materials' densities, the selectors, the proxies'
+  // buffers and geometry, the accelerator) or the summaries were built: an
+  // unchanged Build, or one after a camera, settings or colour change,
+  // keeps the majorants it has.
   bool GridRefittedByLastBuild() const { return gridRefitted_; }
+
+  // When Build last changed each part of what it builds that a backend may
+  // keep a copy of: the voxels (loaded anew or edited), the grid's summaries
+  // (built or updated) and its majorants (refitted). The stamps come from one
+  // process-wide clock, as vtkTimeStamp's do, so a copy made from one Scene
+  // is never taken for current with another (the CUDA backend uploads only
+  // what has a stamp newer than its copy's). 0: never built.
+  struct BuildStamps {
+    uint64_t voxels = 0, summaries = 0, majorants = 0;
+  };
+  const BuildStamps& Stamps() const { return stamps_; }
 
   // A scene built anew from a description over the same voxels (a TF or
   // material edit in a scene file, the proxies moved over from `previous`)
   // takes `previous`'s per-voxel work: the majorant grid's summaries and the
   // value ranges. Then its next Build is a refit, not a rebuild. Nothing is
   // taken unless every proxy is the very buffer `previous` last built from.
-  // Returns whether it was taken.
+  // The voxel and summary stamps come with them. Returns whether it was taken.
   bool AdoptDataSummariesFrom(Scene& previous);
 
  private:
@@ -168,6 +180,7 @@ class Scene {
   std::vector<uint8_t> refitKey_;  // MakeRefitKey() at the last refit
   std::string extinctionWarning_;
   std::vector<std::array<std::array<int, 3>, 2>> modifiedRegions_;
+  BuildStamps stamps_;
 };
 
 }  // namespace mmrtm

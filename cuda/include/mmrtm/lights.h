@@ -67,8 +67,9 @@ struct EnvironmentView {
 
 struct Light {
   LightType type = LightType::Directional;
-  Vec3 vector;  // directional: unit direction toward the light; point: position
-  RGB L;        // directional: irradiance at normal incidence; point: intensity
+  uint8_t padding[3] = {};  // explicit: equal lights have equal bytes (scene_uploads.h)
+  Vec3 vector;              // directional: unit direction toward the light; point: position
+  RGB L;                    // directional: irradiance at normal incidence; point: intensity
 };
 
 struct LightSample {

@@ -36,6 +36,7 @@ MMRTM_CPU_GPU inline int QuantityChannels(Quantity q) {
 struct CoefficientBinding {
   int tf = 0;
   Quantity quantity = Quantity::Density;
+  uint8_t padding[3] = {};  // explicit: equal bindings have equal bytes (scene_uploads.h)
 };
 
 struct MaterialView {

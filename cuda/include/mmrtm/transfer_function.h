@@ -33,6 +33,7 @@ struct TransferFunctionView {
   TFType type = TFType::CCTF;
   uint8_t proxy = 0;     // which proxy volume it reads
   uint8_t channels = 1;  // coefficient TFs: output channels (1 or 3)
+  uint8_t padding0 = 0;  // (padding is explicit: equal views have equal bytes, see scene_uploads.h)
   int count = 0;         // control points, ranges or discrete entries
   // CCTF, CDPTF, MDPTF: count keys, ascending.
   // CPCTF, MPCTF: count [lo, hi) pairs, 2*count floats, in priority order.
@@ -48,6 +49,7 @@ struct TransferFunctionView {
   // correction instead of a binary search (the same segment, hence the same
   // value to the bit); 0 when the keys are not evenly spaced.
   float uniformInverseStep = 0.f;
+  int padding1 = 0;
 
   // Entry index for x, or -1. For a CCTF: the segment start (see Evaluate).
   MMRTM_CPU_GPU int FindEntry(float x) const {

@@ -309,6 +309,54 @@ class SegmentationTest(unittest.TestCase):
                 self.assertEqual([round(v, 6) for v in rgbo], expected)
         self.assertEqual(prop.GetMTime(), before, "rendering left the property alone")
 
+    def test_each_kind_of_edit_does_only_its_work(self):
+        """Each kind of edit a Slicer user makes, one render after it, and
+        the work the mapper did: scene builds, translations, restarts,
+        majorant grid builds and refits. A camera, window or sampling edit
+        restarts only; a colour (of the volume property or of a segment)
+        translates without a grid refit (the majorants read extinction
+        only); an opacity point or a hidden segment refits; edited voxels
+        rebuild; an unchanged render does nothing. (Exposure is not a
+        Slicer display-node setting: the mapper's table, vtkMapper-edits,
+        has it.) Catches work an edit does not need (a refit after a
+        colour, a rebuild after a look change, a restart after nothing) and
+        an edit that does not reach the tracer."""
+        m = self.view.mapper()
+        prop = self.display.GetVolumePropertyNode().GetVolumeProperty()
+        image = self.ct.GetImageData()
+
+        def voxels():
+            scalars = image.GetPointData().GetScalars()
+            scalars.SetTuple1(0, scalars.GetTuple1(0) + 1)
+            scalars.Modified()
+            image.Modified()
+
+        table = (
+            ("unchanged", lambda: None, (0, 0, 0, 0, 0)),
+            ("camera", lambda: self.view.renderer.GetActiveCamera().Azimuth(10), (0, 0, 1, 0, 0)),
+            ("window size", lambda: self.view.window.SetSize(150, 140), (0, 0, 1, 0, 0)),
+            ("sampling setting", lambda: self.display.SetMaximumBounces(2), (0, 0, 1, 0, 0)),
+            ("opacity point", lambda: prop.GetScalarOpacity().AddPoint(400, 0.2), (0, 1, 1, 0, 1)),
+            ("colour point", lambda: prop.GetRGBTransferFunction().AddRGBPoint(100, 0.2, 0.9, 0.1), (0, 1, 1, 0, 0)),
+            ("segment colour", lambda: self.seg_display.SetSegmentOverrideColor(self.liver, 0.0, 0.0, 1.0),
+             (0, 1, 1, 0, 0)),
+            ("segment hidden", lambda: self.seg_display.SetSegmentVisibility(self.liver, False), (0, 1, 1, 0, 1)),
+            ("voxels edited", voxels, (1, 1, 1, 1, 1)),
+        )
+
+        def work():
+            return (m.GetNumberOfSceneBuilds(), m.GetNumberOfRefits(), m.GetNumberOfRestarts(),
+                    m.GetNumberOfMajorantGridBuilds(), m.GetNumberOfMajorantGridRefits())
+
+        for name, edit, expected in table:
+            before = work()
+            edit()
+            self.view.render()
+            done = tuple(after - b for after, b in zip(work(), before))
+            print("%-16s builds, translations, restarts, grid builds, grid refits: %s" % (name, done))
+            self.assertEqual(done, expected, name)
+            self.assertIs(self.view.mapper(), m, "the same mapper")
+
     def test_segment_material_parameters(self):
         before = self.view.pixels()
         self.display.SetSegmentMaterialParameters(self.liver, '{"emission": [0, 3, 0]}')
