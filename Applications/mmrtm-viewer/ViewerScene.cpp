@@ -568,7 +568,7 @@ json ViewerScene::Description() const {
 void ViewerScene::Apply() {
   // The property keeps its modification time when the description is the
   // one it holds: the mapper then neither refits nor restarts.
-  materials_->SetSceneJSON(Description().dump().c_str());
+  materials_->SetScene(Description());
 }
 
 }  // namespace mmrtm::viewer

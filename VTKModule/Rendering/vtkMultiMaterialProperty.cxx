@@ -128,6 +128,19 @@ std::string vtkMultiMaterialProperty::GetSceneJSON()
   return this->Internal->Document.dump(2);
 }
 
+void vtkMultiMaterialProperty::SetScene(const nlohmann::json& scene)
+{
+  if (scene == this->Internal->Document)
+    return;
+  this->Internal->Document = scene;
+  this->Modified();
+}
+
+const nlohmann::json& vtkMultiMaterialProperty::GetScene() const
+{
+  return this->Internal->Document;
+}
+
 void vtkMultiMaterialProperty::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);

@@ -33,6 +33,10 @@
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
 
+#ifndef __VTK_WRAP__
+#include <nlohmann/json_fwd.hpp> // for nlohmann::json
+#endif
+
 class MMRTMRENDERING_EXPORT vtkMultiMaterialProperty : public vtkObject
 {
 public:
@@ -68,6 +72,17 @@ public:
    * The description as JSON text.
    */
   std::string GetSceneJSON();
+
+#ifndef __VTK_WRAP__
+  /**
+   * The description as a JSON value, set and read without going through
+   * text (C++: an editor that changes it on every drag, and the mapper).
+   * SetScene, as the other setters, leaves the modification time when the
+   * value is the one held.
+   */
+  void SetScene(const nlohmann::json& scene);
+  const nlohmann::json& GetScene() const;
+#endif
 
   /**
    * The folder presets are read from.

@@ -1043,7 +1043,7 @@ void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
   // The description over the mapper's volumes: its input as "scalars" (and
   // the mask as "labels"); the camera and image size stay VTK's.
   Internals& in = *this->Internal;
-  nlohmann::json doc = nlohmann::json::parse(in.MultiMaterial->GetSceneJSON());
+  nlohmann::json doc = in.MultiMaterial->GetScene();
   doc.erase("camera");
   doc.erase("volumes"); // a description's own files are not the mapper's data
   mmrtm::SceneInputs inputs;

@@ -118,10 +118,18 @@ class TestMmrtmViewer : public QObject {
     QTest::mousePress(editor, Qt::LeftButton, {}, from);
     QTest::mouseMove(editor, from + QPoint(40, 0));
     QCOMPARE(editor->points()[1].x() > 300, true);
-    QTest::qWait(300);  // the preview renders while the button is held
-    QVERIFY2(m->GetNumberOfRefits() > refits, "dragging refits");
-    QCOMPARE(m->GetAccumulatedSamples(), 0);  // previews do not accumulate
-    QTest::mouseRelease(editor, Qt::LeftButton, {}, from + QPoint(40, 0));
+    QTest::qWait(300);                             // the preview renders while the button is held
+    QCOMPARE(m->GetNumberOfRefits(), refits + 1);  // one change, one refit
+    QCOMPARE(m->GetAccumulatedSamples(), 0);       // previews do not accumulate
+    const double dragged = editor->points()[1].x();
+    QTest::mouseMove(editor, from + QPoint(20, 0));  // back a little
+    QVERIFY(editor->points()[1].x() < dragged);
+    QTest::qWait(300);
+    QCOMPARE(m->GetNumberOfRefits(), refits + 2);
+    QTest::mouseMove(editor, from + QPoint(20, 0));  // no change: the description is the one the mapper has
+    QTest::qWait(300);
+    QCOMPARE(m->GetNumberOfRefits(), refits + 2);
+    QTest::mouseRelease(editor, Qt::LeftButton, {}, from + QPoint(20, 0));
     QVERIFY(RefineTo(v.window, 8));
     QCOMPARE(m->GetNumberOfMajorantGridBuilds(), grids);  // refits only: the summaries were kept
     QVERIFY2(MeanDifference(before, View(v.window)) > 0.002, "the image changed");
