@@ -169,6 +169,11 @@ int vtkMultiMaterialVolumeRepresentation::GetNumberOfLocalRenders()
   return this->Mapper()->GetNumberOfLocalRenders();
 }
 
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfSceneBuilds()
+{
+  return this->Mapper()->GetNumberOfSceneBuilds();
+}
+
 int vtkMultiMaterialVolumeRepresentation::GetNumberOfRefits()
 {
   return this->Mapper()->GetNumberOfRefits();
@@ -177,6 +182,16 @@ int vtkMultiMaterialVolumeRepresentation::GetNumberOfRefits()
 int vtkMultiMaterialVolumeRepresentation::GetNumberOfRestarts()
 {
   return this->Mapper()->GetNumberOfRestarts();
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfMajorantGridBuilds()
+{
+  return this->Mapper()->GetNumberOfMajorantGridBuilds();
+}
+
+int vtkMultiMaterialVolumeRepresentation::GetNumberOfMajorantGridRefits()
+{
+  return this->Mapper()->GetNumberOfMajorantGridRefits();
 }
 
 // Every process asks for the whole volume: each renders samples of the

@@ -137,11 +137,16 @@ public:
 
   ///@{
   /**
-   * The mapper's counters (vtkMultiMaterialVolumeMapper): refits after a
-   * transfer-function change, restarts after any change.
+   * The mapper's counters (vtkMultiMaterialVolumeMapper): scene builds
+   * after a data change, refits (translations of the property) after a
+   * transfer-function change, restarts after any change, and the majorant
+   * grid's builds and refits.
    */
+  int GetNumberOfSceneBuilds();
   int GetNumberOfRefits();
   int GetNumberOfRestarts();
+  int GetNumberOfMajorantGridBuilds();
+  int GetNumberOfMajorantGridRefits();
   ///@}
 
 protected:

@@ -2,7 +2,8 @@
 offered for image data, the head CT renders non-blank with the silhouette
 of ParaView's own "Volume" representation of the same transfer functions,
 a transfer-function edit from Python refits and restarts the accumulation,
-and a camera change restarts it without a refit.
+a camera change restarts it without a refit, and each kind of edit does
+exactly its work (the table).
 
     pvbatch test_plugin.py OUTDIR     (in the ParaView root, under X)
 """
@@ -54,8 +55,8 @@ check(samples == 64, "one still render gives the default 64 samples a pixel (%d)
 refits, restarts = s.counter("NumberOfRefits"), s.counter("NumberOfRestarts")
 s.set_bone_ramp(low=400.0, high=900.0)  # a transfer-function edit
 pv.Render(s.view)
-# pvbatch's Render() renders the view twice, and ParaView touches the volume
-# property between them: one edit may count as two refits, never none.
+# The bone ramp sets the colour and the opacity function: one or two
+# translations, never none (the table below counts single edits exactly).
 check(refits < s.counter("NumberOfRefits") <= refits + 2 and s.counter("NumberOfRestarts") > restarts,
       "a transfer-function edit refits and restarts (refits %d -> %d, restarts %d -> %d)"
       % (refits, s.counter("NumberOfRefits"), restarts, s.counter("NumberOfRestarts")))
@@ -69,6 +70,48 @@ pv.Render(s.view)
 check(s.counter("NumberOfRestarts") == restarts + 1 and s.counter("NumberOfRefits") == refits,
       "a camera change restarts without a refit (restarts %d -> %d, refits %d -> %d)"
       % (restarts, s.counter("NumberOfRestarts"), refits, s.counter("NumberOfRefits")))
+
+# Each kind of edit a ParaView user makes, one render after it, and the
+# work the mapper did: scene builds, translations of the property, restarts,
+# majorant grid builds and refits. Catches work an edit does not need (a
+# refit after a colour, a restart after the exposure or after nothing) and
+# an edit that does not reach the tracer.
+WORK = ("NumberOfSceneBuilds", "NumberOfRefits", "NumberOfRestarts", "NumberOfMajorantGridBuilds",
+        "NumberOfMajorantGridRefits")
+
+
+def work():
+    return tuple(s.counter(name) for name in WORK)
+
+
+def edit_colour():
+    points = list(s.lut.RGBPoints)
+    points[5] = 0.5  # the second point's green
+    s.lut.RGBPoints = points
+
+
+def edit_opacity():
+    points = list(s.pwf.Points)
+    points[9] = 0.6  # the third point's opacity
+    s.pwf.Points = points
+
+
+pv.Render(s.view)
+for name, edit, expected in (
+        ("unchanged", lambda: None, (0, 0, 0, 0, 0)),
+        ("camera", lambda: s.view.GetActiveCamera().Azimuth(10), (0, 0, 1, 0, 0)),
+        ("window size", lambda: setattr(s.view, "ViewSize", [240, 256]), (0, 0, 1, 0, 0)),
+        ("sampling setting", lambda: setattr(s.display, "MaximumBounces", 3), (0, 0, 1, 0, 0)),
+        ("exposure", lambda: setattr(s.display, "PathTracingExposure", 1.5), (0, 0, 0, 0, 0)),
+        ("colour point", edit_colour, (0, 1, 1, 0, 0)),
+        ("opacity point", edit_opacity, (0, 1, 1, 0, 1))):
+    before = work()
+    edit()
+    pv.Render(s.view)
+    done = tuple(a - b for a, b in zip(work(), before))
+    check(done == expected, "%-16s builds, translations, restarts, grid builds, grid refits: %s (expected %s)"
+          % (name, done, expected))
+s.view.ViewSize = [256, 256]
 
 s.display.Preset = "ct-bone"
 pv.Render(s.view)
