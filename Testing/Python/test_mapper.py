@@ -293,6 +293,10 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.mapper.GetNumberOfInteractiveRenders(), 1)
         self.assertEqual(s.mapper.GetAccumulatedSamples(), 0, "a preview does not accumulate")
         self.assertGreater(coverage(s.pixels()), 0.05, "the preview shows the volume")  # renders a preview again
+        restarts = s.mapper.GetNumberOfRestarts()
+        s.render()
+        self.assertEqual(s.mapper.GetNumberOfRestarts(), restarts,
+                         "previews with nothing changed between them restart nothing")
         previews = s.mapper.GetNumberOfInteractiveRenders()
         # When the camera stops, the full-resolution accumulation starts again.
         s.window.SetDesiredUpdateRate(0.0001)

@@ -645,7 +645,10 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       this->UpdateDescription(now);
     if (!now.Proxies.MultiMaterial && (changes.Proxies || changes.Materials))
       this->UpdateMaterials(now);
-    const bool restart = changes.Any() || !in.Film;
+    // A preview leaves no film (the still render after the interaction
+    // starts again at full resolution); previews between changes are drawn
+    // from the scene as it is: no restart.
+    const bool restart = changes.Any() || (!in.Film && !interactive);
     if (restart)
       this->UpdateView(ren, vol, now);
     this->UpdateRenderer();

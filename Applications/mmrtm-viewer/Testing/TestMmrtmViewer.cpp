@@ -110,7 +110,8 @@ class TestMmrtmViewer : public QObject {
     QVERIFY(RefineTo(v.window, 8));
     const QImage before = View(v.window);
     vtkMultiMaterialVolumeMapper* m = v.window.scene().Mapper();
-    const int refits = m->GetNumberOfRefits(), grids = m->GetNumberOfMajorantGridBuilds();
+    const int refits = m->GetNumberOfRefits(), restarts = m->GetNumberOfRestarts(),
+              grids = m->GetNumberOfMajorantGridBuilds();
     mmrtm::viewer::TransferFunctionEditor* editor = v.window.transferFunctionEditor();
     // The ct-bone density curve's middle point, dragged to the right (less bone).
     QCOMPARE(editor->points().size(), 3);
@@ -119,16 +120,19 @@ class TestMmrtmViewer : public QObject {
     QTest::mouseMove(editor, from + QPoint(40, 0));
     QCOMPARE(editor->points()[1].x() > 300, true);
     QTest::qWait(300);                             // the preview renders while the button is held
-    QCOMPARE(m->GetNumberOfRefits(), refits + 1);  // one change, one refit
-    QCOMPARE(m->GetAccumulatedSamples(), 0);       // previews do not accumulate
+    QCOMPARE(m->GetNumberOfRefits(), refits + 1);  // one change, one refit and one restart
+    QCOMPARE(m->GetNumberOfRestarts(), restarts + 1);
+    QCOMPARE(m->GetAccumulatedSamples(), 0);  // previews do not accumulate
     const double dragged = editor->points()[1].x();
     QTest::mouseMove(editor, from + QPoint(20, 0));  // back a little
     QVERIFY(editor->points()[1].x() < dragged);
     QTest::qWait(300);
     QCOMPARE(m->GetNumberOfRefits(), refits + 2);
+    QCOMPARE(m->GetNumberOfRestarts(), restarts + 2);
     QTest::mouseMove(editor, from + QPoint(20, 0));  // no change: the description is the one the mapper has
     QTest::qWait(300);
     QCOMPARE(m->GetNumberOfRefits(), refits + 2);
+    QCOMPARE(m->GetNumberOfRestarts(), restarts + 2);
     QTest::mouseRelease(editor, Qt::LeftButton, {}, from + QPoint(20, 0));
     QVERIFY(RefineTo(v.window, 8));
     QCOMPARE(m->GetNumberOfMajorantGridBuilds(), grids);  // refits only: the summaries were kept
