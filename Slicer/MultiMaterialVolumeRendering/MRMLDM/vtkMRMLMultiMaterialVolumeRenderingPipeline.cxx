@@ -44,11 +44,58 @@
 #include <vtkWeakPointer.h>
 
 #include <algorithm>
-#include <sstream>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 vtkStandardNewMacro(vtkMRMLMultiMaterialVolumeRenderingPipeline);
+
+namespace
+{
+// What the label map is made of, by the pointers and modification times VTK
+// keeps: the segments (their order and binary labelmaps), the volume's
+// image and node, and both nodes' parent transforms. The label map is
+// exported again when they differ from the last export's.
+struct LabelMapInputs
+{
+  std::vector<std::string> Segments;
+  std::vector<std::pair<vtkDataObject*, vtkMTimeType>> Labelmaps;
+  vtkImageData* Image = nullptr;
+  vtkMTimeType ImageTime = 0, VolumeNodeTime = 0;
+  std::vector<std::pair<vtkMRMLTransformNode*, vtkMTimeType>> Transforms;
+
+  bool operator==(const LabelMapInputs& o) const
+  {
+    return std::tie(Segments, Labelmaps, Image, ImageTime, VolumeNodeTime, Transforms) ==
+      std::tie(o.Segments, o.Labelmaps, o.Image, o.ImageTime, o.VolumeNodeTime, o.Transforms);
+  }
+};
+
+LabelMapInputs ReadLabelMapInputs(vtkMRMLSegmentationNode* segmentation, vtkMRMLVolumeNode* volume)
+{
+  LabelMapInputs now;
+  vtkSegmentation* segments = segmentation->GetSegmentation();
+  segments->GetSegmentIDs(now.Segments);
+  const char* labelmap = vtkSegmentationConverter::GetBinaryLabelmapRepresentationName();
+  for (const std::string& id : now.Segments)
+  {
+    vtkSegment* segment = segments->GetSegment(id);
+    vtkDataObject* data = segment ? segment->GetRepresentation(labelmap) : nullptr;
+    now.Labelmaps.emplace_back(data, data ? data->GetMTime() : 0);
+  }
+  now.Image = volume->GetImageData();
+  now.ImageTime = now.Image ? now.Image->GetMTime() : 0;
+  now.VolumeNodeTime = volume->GetMTime();
+  for (vtkMRMLTransformableNode* node :
+    { static_cast<vtkMRMLTransformableNode*>(volume), static_cast<vtkMRMLTransformableNode*>(segmentation) })
+  {
+    vtkMRMLTransformNode* parent = node->GetParentTransformNode();
+    now.Transforms.emplace_back(parent, parent ? parent->GetTransformToWorldMTime() : 0);
+  }
+  return now;
+}
+}
 
 struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
 {
@@ -60,11 +107,10 @@ struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
   vtkWeakPointer<vtkMRMLNode> VolumeNode, PropertyNode, ROINode, SegmentationNode, SegmentationDisplayNode;
 
   // With a segmentation: the label map on the volume's grid, the segment
-  // of each label, and a copy of the volume property with the segments'
-  // label functions (the node's own property stays as the user made it).
+  // of each label, and what the label map was last exported from.
   vtkNew<vtkImageData> LabelMap;
   vtkNew<vtkStringArray> SegmentIds;
-  std::string LabelMapSignature;
+  LabelMapInputs LabelMapExported;
   std::string MaterialDescription = "\n"; // preset and JSON last applied ("\n": none yet)
 
   std::vector<double> ClipPlanes; // the planes last applied, by value
@@ -251,36 +297,6 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateGeometry()
   }
 }
 
-namespace
-{
-// What the label map is made of: the segments, their order and their
-// binary labelmaps, the volume's grid and both nodes' transforms.
-std::string LabelMapSignature(vtkMRMLSegmentationNode* segmentation, vtkMRMLVolumeNode* volume)
-{
-  std::ostringstream s;
-  vtkSegmentation* segments = segmentation->GetSegmentation();
-  std::vector<std::string> ids;
-  segments->GetSegmentIDs(ids);
-  const char* labelmap = vtkSegmentationConverter::GetBinaryLabelmapRepresentationName();
-  for (const std::string& id : ids)
-  {
-    s << id << ':';
-    if (vtkSegment* segment = segments->GetSegment(id))
-      if (vtkDataObject* data = segment->GetRepresentation(labelmap))
-        s << data << '@' << data->GetMTime();
-    s << ';';
-  }
-  s << volume->GetImageData() << '@' << volume->GetImageData()->GetMTime() << ';' << volume->GetMTime();
-  for (vtkMRMLTransformableNode* node :
-    { static_cast<vtkMRMLTransformableNode*>(volume), static_cast<vtkMRMLTransformableNode*>(segmentation) })
-  {
-    vtkMRMLTransformNode* parent = node->GetParentTransformNode();
-    s << ';' << parent << '@' << (parent ? parent->GetTransformToWorldMTime() : 0);
-  }
-  return s.str();
-}
-}
-
 // The volume property node's property, as it is (rendering never changes
 // it); with a segmentation, its segments as the mapper's label materials;
 // then the material preset and the segments' material parameters.
@@ -293,12 +309,12 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
   bool labels = false;
   if (segmentation && segmentation->GetSegmentation())
   {
-    const std::string mapSignature = LabelMapSignature(segmentation, node->GetVolumeNode());
-    if (mapSignature != in.LabelMapSignature)
+    LabelMapInputs inputs = ReadLabelMapInputs(segmentation, node->GetVolumeNode());
+    if (!(inputs == in.LabelMapExported))
     {
       vtkSlicerMultiMaterialVolumeRenderingLogic::ExportSegmentLabelMap(node, in.LabelMap, in.SegmentIds);
       in.LabelMap->Modified();
-      in.LabelMapSignature = mapSignature;
+      in.LabelMapExported = std::move(inputs);
       in.Mapper->RemoveAllLabelMaterials(); // the labels are numbered anew
     }
     labels = in.SegmentIds->GetNumberOfValues() > 0;
