@@ -331,6 +331,27 @@ mmrtm::Affine3 ToAffine(vtkMatrix4x4* m)
       a.m[r][c] = static_cast<float>(m->GetElement(r, c));
   return a;
 }
+
+// The cropping regions of any flags but the subvolume's (ClipPlanes clips
+// that one exactly), tested per point in the data's coordinates.
+mmrtm::Scene::Cropping CroppingRegions(vtkVolumeMapper* mapper, vtkVolume* vol)
+{
+  mmrtm::Scene::Cropping cropping;
+  if (!mapper->GetCropping() || mapper->GetCroppingRegionFlags() == VTK_CROP_SUBVOLUME)
+    return cropping;
+  vtkNew<vtkMatrix4x4> inverse;
+  vol->GetMatrix(inverse);
+  inverse->Invert();
+  cropping.worldToData = ToAffine(inverse);
+  cropping.keep = static_cast<uint32_t>(mapper->GetCroppingRegionFlags()) & mmrtm::Classifier::kNoCropping;
+  const double* planes = mapper->GetCroppingRegionPlanes();
+  for (int a = 0; a < 3; ++a)
+  {
+    cropping.lo[a] = static_cast<float>(planes[2 * a]);
+    cropping.hi[a] = static_cast<float>(planes[2 * a + 1]);
+  }
+  return cropping;
+}
 }
 
 vtkMultiMaterialVolumeMapper::vtkMultiMaterialVolumeMapper()
@@ -679,8 +700,6 @@ bool vtkMultiMaterialVolumeMapper::ValidateInputs(vtkRenderer* ren, vtkVolume* v
   }
   if (in.Warn("blend mode", this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND))
     vtkWarningMacro("only composite blending is supported; rendering as composite");
-  if (in.Warn("cropping region", this->Cropping && this->CroppingRegionFlags != VTK_CROP_SUBVOLUME))
-    vtkWarningMacro("only the subvolume cropping region (VTK_CROP_SUBVOLUME) is supported; not cropping");
   ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
   return viewport[0] > 0 && viewport[1] > 0;
 }
@@ -824,6 +843,7 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
   if (in.Environment)
     in.Scene.environment = in.Environment;
   in.Scene.clipPlanes = now.View.Clip;
+  in.Scene.cropping = CroppingRegions(this, vol);
   mmrtm::RenderSettings& rs = in.Scene.render;
   rs.width = width;
   rs.height = height;

@@ -414,6 +414,14 @@ SceneView Scene::Build() {
     }
     s.majorants.grid = grid_->View();
   }
+  // Cropping after the refit, which bounds the uncropped volume.
+  c.cropKeep = cropping.keep;
+  c.worldToCrop = cropping.worldToData;
+  for (int a = 0; a < 3; ++a) {
+    c.cropLo[a] = cropping.lo[a];
+    c.cropHi[a] = cropping.hi[a];
+  }
+  if (cropping.keep != Classifier::kNoCropping) s.majorants.grid.minorants = nullptr;
   dataModified_ = false;
   modifiedRegions_.clear();
 

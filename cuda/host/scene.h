@@ -103,6 +103,16 @@ class Scene {
   std::vector<float> cameraRayMaxDistance;
   // Half-spaces the volume is seen in (at most kMaxClipPlanes).
   std::vector<ClipPlane> clipPlanes;
+  // VTK's cropping regions (Classifier::cropKeep): which of the 27 regions
+  // between the planes [lo, hi] of the data's coordinates (worldToData
+  // takes a world point there) are kept. A crop edit is a view change: no
+  // refit (the majorants ignore it); while cropping, the minorants are not
+  // used (a cropped cell's density falls below its minorant).
+  struct Cropping {
+    uint32_t keep = Classifier::kNoCropping;
+    Affine3 worldToData;
+    float lo[3] = {0.f, 0.f, 0.f}, hi[3] = {0.f, 0.f, 0.f};
+  } cropping;
 
   int ProxyIndex(const std::string& name) const;  // -1 if absent
   int MaterialIndex(const std::string& name) const;

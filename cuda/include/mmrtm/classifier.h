@@ -71,6 +71,27 @@ struct Classifier {
   // majorants are clamped alike, so they stay bounds.
   float maxExtinction = kInfinity;
 
+  // VTK's cropping regions (vtkVolumeMapper::SetCroppingRegionFlags) other
+  // than the subvolume, which SceneView::DomainInterval clips: two planes
+  // per axis of the data's coordinates (`worldToCrop` takes a world point
+  // there) cut space into 27 regions, region x + 3y + 9z (each 0 below the
+  // low plane, 1 between, 2 above) kept where its bit of cropKeep is set,
+  // as VTK numbers them. The volume is empty elsewhere. kNoCropping: all
+  // kept. The majorants ignore cropping (they stay bounds; Scene::Build
+  // drops the minorants while cropping).
+  static constexpr uint32_t kNoCropping = (1u << 27) - 1u;
+  uint32_t cropKeep = kNoCropping;
+  Affine3 worldToCrop;
+  float cropLo[3] = {0.f, 0.f, 0.f}, cropHi[3] = {0.f, 0.f, 0.f};
+
+  MMRTM_CPU_GPU bool Cropped(Vec3 world) const {
+    const Vec3 p = worldToCrop.ApplyPoint(world);
+    const float x[3] = {p.x, p.y, p.z};
+    int region = 0;
+    for (int a = 2; a >= 0; --a) region = 3 * region + (x[a] < cropLo[a] ? 0 : x[a] > cropHi[a] ? 2 : 1);
+    return !((cropKeep >> region) & 1u);
+  }
+
   // Proxies on proxy 0's voxel grid (OnSameVoxelGrid: a label map or a
   // derived proxy resampled to the image; proxy 0 itself) are sampled at
   // proxy 0's index coordinates, which the tracker has from its index-space
@@ -111,6 +132,7 @@ struct Classifier {
   // tracker computes it from its index-space ray).
   MMRTM_CPU_GPU Classification Classify(Vec3 world, Vec3 index0) const {
     Classification c;
+    if (cropKeep != kNoCropping && Cropped(world)) return c;
 #ifdef MMRTM_PLAIN_SCENE_ONLY
     // Compiled only into the benchmark that measures what the general path
     // costs a plain scene (Testing/Benchmarks/mmrtm-bench-plain-scene.cpp).
