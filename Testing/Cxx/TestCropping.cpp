@@ -40,8 +40,8 @@ TEST(Cropping, EachRegionIsKeptExactlyWhenItsBitIsSet) {
       float* x = &p.x;
       for (int a = 0; a < 3; ++a) x[a] = r[a] == 0 ? 5.f : r[a] == 1 ? 15.f : 25.f;
       const bool kept = (flags >> region) & 1u;
-      EXPECT_EQ(view.classifier.Classify(p).sigma_t > 0.f, kept) << "flags 0x" << std::hex << flags << std::dec
-                                                                  << ", region " << region;
+      EXPECT_EQ(view.classifier.Classify(p).sigma_t > 0.f, kept)
+          << "flags 0x" << std::hex << flags << std::dec << ", region " << region;
     }
   }
 }
