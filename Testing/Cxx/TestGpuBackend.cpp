@@ -183,6 +183,16 @@ TEST(GpuBackend, AfterEachEditTheKeptDeviceSceneRendersAsAFreshUpload) {
          for (size_t i = 0; i < v.voxels.size() / 2; i += 3) voxels[i] = 1500;
          scene.MarkDataModified();
        }},
+      {"cropping (no minorants)",
+       [&] {
+         scene.cropping.keep = 0x2ebfeba;  // VTK's fence
+         const auto b = scene.proxies[0].WorldBounds();
+         for (int a = 0; a < 3; ++a) {
+           scene.cropping.lo[a] = 0.6f * (&b[0].x)[a] + 0.4f * (&b[1].x)[a];
+           scene.cropping.hi[a] = 0.4f * (&b[0].x)[a] + 0.6f * (&b[1].x)[a];
+         }
+       }},
+      {"cropping off", [&] { scene.cropping.keep = Classifier::kNoCropping; }},
       {"nothing", [] {}},
   };
   for (const auto& [name, edit] : edits) {

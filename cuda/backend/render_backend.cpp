@@ -75,8 +75,9 @@ class CudaBackend : public Renderer {
       const SceneUploads uploads = uploads_.Plan(scene, view);
       gpu_.SetScene(view, uploads);
       const MajorantGrid* grid = scene.Grid();
+      // (Without minorants, as while cropping, the host's majorants went up as they are.)
       if (uploads.majorants && grid && view.majorants.kind != MajorantKind::Global &&
-          scene.render.accelerator.grid.summary == SummaryMode::CellRanges)
+          view.majorants.grid.minorants && scene.render.accelerator.grid.summary == SummaryMode::CellRanges)
         gpu_.Refit(*grid, view.classifier, uploads.summaries);
       onDevice();
       return true;
