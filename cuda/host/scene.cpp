@@ -421,7 +421,10 @@ SceneView Scene::Build() {
     c.cropLo[a] = cropping.lo[a];
     c.cropHi[a] = cropping.hi[a];
   }
-  if (cropping.keep != Classifier::kNoCropping) s.majorants.grid.minorants = nullptr;
+  if (cropping.keep != Classifier::kNoCropping) {
+    s.majorants.grid.minorants = nullptr;
+    c.plain = false;  // its shortest path does not crop
+  }
   dataModified_ = false;
   modifiedRegions_.clear();
 

@@ -58,9 +58,9 @@ struct Classifier {
   // probability sigma_m / sigma_t). Material TFs and the default are unused.
   bool additive = false;
   // A plain scene: one proxy, one material (the default) with one density
-  // TF, no material TFs, not additive. Classify then takes its shortest path
-  // (one lookup, one TF), so that the multi-material machinery costs such a
-  // scene nothing (DESIGN.md rule 3; Documentation/performance.md).
+  // TF, no material TFs, not additive, not cropped. Classify then takes its
+  // shortest path (one lookup, one TF), so that the multi-material
+  // machinery costs such a scene nothing (DESIGN.md rule 3; Documentation/performance.md).
   bool plain = false;
   // sigma_t is at most this (per mm): Scene::Build sets it to an optical
   // depth of kMaxOpticalDepthPerVoxel over the tracked volume's finest
@@ -132,7 +132,6 @@ struct Classifier {
   // tracker computes it from its index-space ray).
   MMRTM_CPU_GPU Classification Classify(Vec3 world, Vec3 index0) const {
     Classification c;
-    if (cropKeep != kNoCropping && Cropped(world)) return c;
 #ifdef MMRTM_PLAIN_SCENE_ONLY
     // Compiled only into the benchmark that measures what the general path
     // costs a plain scene (Testing/Benchmarks/mmrtm-bench-plain-scene.cpp).
@@ -148,6 +147,7 @@ struct Classifier {
       c.material = 0;
       return c;
     }
+    if (cropKeep != kNoCropping && Cropped(world)) return c;  // (a cropped scene is not plain)
     SampleProxies(world, index0, &c.proxies);
     if (additive) {
       for (int m = 0; m < materialCount; ++m) c.sigma_t += Density(m, c.proxies);
