@@ -28,11 +28,11 @@
  * opaque geometry VTK drew first (its depth buffer), so where that geometry
  * is in front the image is transparent.
  *
- * Clipping planes (world space) and subvolume cropping (data space) limit
- * what is seen. Not supported yet (a warning is given once): blend modes
- * other than composite, cropping regions other than the subvolume, more
- * than four independent components, gradient opacity of independent
- * components beyond the four proxies.
+ * Clipping planes (world space) and cropping (data space, every region
+ * set) limit what is seen. Not supported yet (a warning is given once per
+ * cause): blend modes other than composite, more than four independent
+ * components, gradient opacity of independent components beyond the four
+ * proxies.
  *
  * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
  */
