@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -170,10 +171,16 @@ TEST(GpuBackend, AfterEachEditTheKeptDeviceSceneRendersAsAFreshUpload) {
     return film.Linear();
   };
   render(*kept, scene.Build());
+  // The preset's TFs by what they are bound to (their order is the JSON's).
+  auto boundTo = [&](Quantity q) -> TransferFunctionDesc& {
+    for (const MaterialDesc::Binding& b : scene.materials[0].bindings)
+      if (b.quantity == q) return scene.tfs[(size_t)b.tf];
+    throw std::runtime_error("ct-bone has no TF for that quantity");
+  };
   const std::vector<std::pair<std::string, std::function<void()>>> edits = {
       {"camera", [&] { scene.camera.azimuth += 40.f; }},
-      {"albedo TF", [&] { scene.tfs[1].values[0] = 0.2f; }},
-      {"density TF", [&] { scene.tfs[0].values[1] = 0.9f; }},
+      {"albedo TF", [&] { boundTo(Quantity::Albedo).values[0] = 0.2f; }},
+      {"density TF", [&] { boundTo(Quantity::Density).values[1] = 0.9f; }},
       {"material colour", [&] { scene.materials[0].base[1] = 0.3f; }},
       {"voxels edited in place",
        [&] {

@@ -71,8 +71,18 @@ std::string vtkMultiMaterialProperty::GetPresetDirectory()
 
 namespace
 {
-// Runs `change` on the document; an exception (a missing file, bad JSON)
-// becomes a VTK error naming the problem, and the document stays as it was.
+// As vtkSetMacro: an unchanged value leaves the modification time.
+void SetDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, nlohmann::json next)
+{
+  if (next == document)
+    return;
+  document = std::move(next);
+  self->Modified();
+}
+
+// Runs `change` on a copy of the document; an exception (a missing file,
+// bad JSON) becomes a VTK error naming the problem, and the document stays
+// as it was.
 template <typename Change>
 bool ChangeDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, Change change)
 {
@@ -86,10 +96,7 @@ bool ChangeDocument(vtkMultiMaterialProperty* self, nlohmann::json& document, Ch
     vtkErrorWithObjectMacro(self, << e.what());
     return false;
   }
-  if (next == document) // as vtkSetMacro: an unchanged value leaves the modification time
-    return true;
-  document = std::move(next);
-  self->Modified();
+  SetDocument(self, document, std::move(next));
   return true;
 }
 
@@ -130,10 +137,7 @@ std::string vtkMultiMaterialProperty::GetSceneJSON()
 
 void vtkMultiMaterialProperty::SetScene(const nlohmann::json& scene)
 {
-  if (scene == this->Internal->Document)
-    return;
-  this->Internal->Document = scene;
-  this->Modified();
+  SetDocument(this, this->Internal->Document, scene);
 }
 
 const nlohmann::json& vtkMultiMaterialProperty::GetScene() const
