@@ -62,6 +62,32 @@ TEST(Camera, ThinLensFocusesOnItsFocusPlane) {
   EXPECT_NEAR(Length(onFocusPlane(a) - onFocusPlane(b)), 0.f, 1e-4f);
 }
 
+// A tile of a 2 x 2 magnified image, as vtkWindowToImageFilter renders it:
+// the same film size, half the view window (tan of half the angle halved,
+// or half the parallel scale) and the window centre on the tile. Its rays
+// must be the large image's rays through the same points. Catches a window
+// centre ignored (every tile the middle of the view) or applied with the
+// wrong sign or scale (tiles swapped, stretched).
+TEST(Camera, ATileWithItsWindowCentreSeesItsPartOfTheLargeImage) {
+  for (Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    CameraView large = LookAlongY(projection);
+    large.width *= 2;
+    large.height *= 2;
+    CameraView tile = LookAlongY(projection);
+    tile.tanHalfFovY = 0.5f * large.tanHalfFovY;
+    tile.orthoHalfHeight = 0.5f * large.orthoHalfHeight;
+    tile.windowCenterX = 1.f;   // the right half
+    tile.windowCenterY = -1.f;  // the bottom half
+    for (float px : {0.f, 37.5f, 200.f})
+      for (float py : {0.f, 61.f, 100.f}) {
+        const Ray a = tile.GenerateRay(px, py, 0.5f, 0.5f);
+        const Ray b = large.GenerateRay(px + tile.width, py + tile.height, 0.5f, 0.5f);
+        EXPECT_NEAR(Length(a.d - b.d), 0.f, 1e-5f) << px << " " << py;
+        EXPECT_NEAR(Length(a.o - b.o), 0.f, 1e-4f) << px << " " << py;
+      }
+  }
+}
+
 TEST(ImageFiles, PfmRoundTripKeepsFloatsAndOrientation) {
   RGBImage image{3, 2, {RGB(0.f, 1.f, 2.f), RGB(3.f), RGB(4.f), RGB(5.f), RGB(6.f), RGB(1e-8f, 1e8f, 0.5f)}};
   WritePFM(Scratch("roundtrip.pfm"), image);

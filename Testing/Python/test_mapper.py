@@ -168,6 +168,54 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
 
+    def test_a_magnified_screenshot_keeps_the_view_accumulating(self):
+        """vtkWindowToImageFilter::SetScale(2) renders the window as 2 x 2
+        tiles: each tile is traced with as many samples as the view had, and
+        the view goes on accumulating after the screenshot instead of
+        starting again. Catches tiles traced with SamplesPerRender only (a
+        screenshot noisier than the view), and the view's film lost to the
+        tiles."""
+        s = Scene()
+        for _ in range(3):
+            s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 6)
+        grab = vtkWindowToImageFilter()
+        grab.SetInput(s.window)
+        grab.SetScale(2)
+        grab.ReadFrontBufferOff()
+        tile_samples = []
+        s.renderer.AddObserver("EndEvent", lambda *_: tile_samples.append(s.mapper.GetAccumulatedSamples()))
+        grab.Update()
+        self.assertEqual(grab.GetOutput().GetDimensions()[:2], (256, 256))
+        self.assertEqual(tile_samples[-4:], [6, 6, 6, 6], "each tile as many samples as the view")
+        self.assertEqual(s.counts(), (1, 1, 5), "a restart per tile")
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 8, "the view went on from its 6 samples")
+        self.assertEqual(s.counts(), (1, 1, 5))
+
+    def test_a_mapper_shared_by_two_renderers_converges_in_each(self):
+        """One mapper on one volume shown in two renderers (two viewports,
+        cameras from two sides): each renderer's view keeps its own
+        accumulation. Catches the views restarting each other at every
+        render (each stayed at SamplesPerRender)."""
+        s = Scene()
+        s.renderer.SetViewport(0, 0, 0.5, 1)
+        other = vtkRenderer()
+        other.SetViewport(0.5, 0, 1, 1)
+        other.AddVolume(s.volume)
+        s.window.AddRenderer(other)
+        other.ResetCamera()
+        other.GetActiveCamera().Azimuth(90)
+        seen = {}
+        for ren in (s.renderer, other):
+            ren.AddObserver("EndEvent", lambda r, _e: seen.setdefault(r, []).append(s.mapper.GetAccumulatedSamples()))
+        for _ in range(5):
+            s.render()
+        self.assertEqual(seen[s.renderer], [2, 4, 6, 8, 8])
+        self.assertEqual(seen[other], [2, 4, 6, 8, 8])
+        self.assertEqual(s.counts(), (1, 1, 2), "one restart per view")
+        self.assertGreater(coverage(s.pixels()), 0.05)
+
     def test_transfer_function_change_refits_and_restarts(self):
         s = Scene()
         for _ in range(3):

@@ -569,6 +569,9 @@ void SetCameraFromVtk(vtkCamera* camera, Scene& scene)
   c.lookAt = { (float)f[0], (float)f[1], (float)f[2] };
   c.up = { (float)u[0], (float)u[1], (float)u[2] };
   c.lensRadius = 0.f;
+  const double* center = camera->GetWindowCenter();
+  c.windowCenter[0] = (float)center[0];
+  c.windowCenter[1] = (float)center[1];
   if (camera->GetParallelProjection())
   {
     c.projection = Projection::Orthographic;

@@ -92,6 +92,12 @@ struct vtkMultiMaterialVolumeMapper::InputState
     std::vector<mmrtm::ClipPlane> Clip;
     std::vector<float> Depth; // the depth buffer under the volume
     vtkMTimeType TracingTime = 0;
+    // Which view of the mapper's this is: a renderer and volume (one
+    // mapper may serve several), and whether it is a tile of a magnified
+    // image (vtkWindowToImageFilter::SetScale, vtkRenderLargeImage).
+    vtkRenderer* Renderer = nullptr;
+    vtkVolume* Volume = nullptr;
+    bool Tile = false;
   } View;
 };
 
@@ -141,6 +147,12 @@ struct vtkMultiMaterialVolumeMapper::Internals
   // The inputs as the scene and the film were last made from them; each
   // render compares what it finds with these (ChangesSince).
   InputState Built;
+  // The accumulation of the view before, while another is drawn: the whole
+  // view during the tiles of a magnified screenshot, or another renderer's
+  // or volume's view of this mapper. The film goes on when its view comes
+  // back (TakeFilm); a change of the scene drops it.
+  std::unique_ptr<mmrtm::Film> ParkedFilm;
+  InputState::ViewInputs ParkedView;
   bool HasScene = false; // false until a build succeeds, and after a failed one
 
   // Whether each warning's cause held when it was last checked: a warning
@@ -240,6 +252,7 @@ std::vector<double> ViewSignature(vtkRenderer* ren, vtkVolume* vol, int width, i
   add(cam->GetPosition(), 3);
   add(cam->GetFocalPoint(), 3);
   add(cam->GetViewUp(), 3);
+  add(cam->GetWindowCenter(), 2);
   v.push_back(cam->GetViewAngle());
   v.push_back(cam->GetParallelProjection());
   v.push_back(cam->GetParallelScale());
@@ -670,6 +683,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // starts again at full resolution); previews between changes are drawn
     // from the scene as it is: no restart.
     const bool restart = changes.Any() || (!in.Film && !interactive);
+    if (changes.Proxies || changes.Description || changes.Materials)
+      in.ParkedFilm.reset(); // accumulated under the scene before
     if (restart)
       this->UpdateView(ren, vol, now);
     this->UpdateRenderer();
@@ -761,6 +776,10 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   now.View.Values.push_back(static_cast<double>(in.EnvironmentTime));
   now.View.Depth = ReadDepth(ren, viewport[0], viewport[1], viewport[2], viewport[3]);
   now.View.TracingTime = this->TracingMTime();
+  now.View.Renderer = ren;
+  now.View.Volume = vol;
+  const int* tiles = ren->GetRenderWindow()->GetTileScale();
+  now.View.Tile = tiles[0] > 1 || tiles[1] > 1;
   return now;
 }
 
@@ -857,10 +876,42 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
     : this->Accelerator == NO_ACCELERATOR              ? mmrtm::MajorantKind::Global
                                                        : mmrtm::MajorantKind::Octree;
   rs.integrator.backgroundVisible = false; // VTK's background shows through
-  in.Film = std::make_unique<mmrtm::Film>(width, height);
+  this->TakeFilm(now);
   in.Built.View = std::move(now.View);
   in.HasScene = true;
-  ++in.Restarts;
+}
+
+// The film for the view `now`: the parked one when it was made under this very
+// view, else a new one (a restart). The film of the view before is parked
+// when the view is a tile, or another renderer's or volume's view of this
+// mapper, and the film before was neither a tile nor empty: after a
+// magnified screenshot, and between the views of a mapper shared by two
+// renderers, each view goes on accumulating.
+void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
+{
+  Internals& in = *this->Internal;
+  const InputState::ViewInputs& view = now.View;
+  const InputState::ViewInputs& before = in.Built.View;
+  const bool otherView = view.Tile || view.Renderer != before.Renderer || view.Volume != before.Volume;
+  std::unique_ptr<mmrtm::Film> previous = std::move(in.Film);
+  const bool keepPrevious = otherView && previous && previous->Samples() > 0 && !before.Tile;
+  const InputState::ViewInputs& parked = in.ParkedView;
+  if (in.ParkedFilm && !view.Tile && SameView(view.Values, parked.Values) && view.Depth == parked.Depth &&
+    view.TracingTime == parked.TracingTime && view.Renderer == parked.Renderer && view.Volume == parked.Volume)
+  {
+    in.Film = std::move(in.ParkedFilm);
+  }
+  else
+  {
+    in.Film = std::make_unique<mmrtm::Film>(view.Width, view.Height);
+    ++in.Restarts;
+  }
+  if (keepPrevious)
+  {
+    in.ParkedFilm = std::move(previous);
+    in.ParkedView = before;
+  }
+  in.Shown.reset(); // the image of the view before
 }
 
 void vtkMultiMaterialVolumeMapper::UpdateRenderer()
@@ -895,9 +946,14 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   if (restart && (in.Scene.GridRefittedByLastBuild() || !in.Scene.Grid()))
     in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
   const int accumulated = static_cast<int>(in.Film->Samples());
+  // A tile of a magnified screenshot is drawn once: with as many samples
+  // as the view it magnifies has.
+  const int perRender = in.Built.View.Tile && in.ParkedFilm
+    ? std::max(this->SamplesPerRender, static_cast<int>(in.ParkedFilm->Samples()))
+    : this->SamplesPerRender;
   const int samples = this->IsConverged() ? 0
-    : this->MaximumSamples > 0            ? std::min(this->SamplesPerRender, this->MaximumSamples - accumulated)
-                                          : this->SamplesPerRender;
+    : this->MaximumSamples > 0            ? std::min(perRender, this->MaximumSamples - accumulated)
+                                          : perRender;
   if (samples > 0 && this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown)
   {
     // The next pass on a thread of its own, under in.Built; this render
@@ -1222,8 +1278,28 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
     }
     helper->PreMultipliedColorsOn();
   }
-  int size[2] = { width, height }, origin[2] = { 0, 0 };
-  helper->RenderTexture(vol, ren, size, size, size, origin, depth, rgba.data());
+  int viewport[4];
+  ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
+  int origin[2] = { 0, 0 };
+  if (width != viewport[0] || height != viewport[1])
+  {
+    int size[2] = { width, height }; // a preview: stretched
+    helper->RenderTexture(vol, ren, size, size, size, origin, depth, rgba.data());
+    return;
+  }
+  // The helper maps the quad's corners to texel centres, which resamples
+  // the image by (n - 1) / n: up to half a pixel of blur towards the
+  // edges, the more the smaller the image (a tile of a magnified
+  // screenshot blurred its middle). Each pixel drawn as 2 x 2 texels, the
+  // viewport counted twice as large, puts every pixel's sample among its
+  // own texels: the image is drawn as it is.
+  std::vector<uint8_t> doubled(4 * rgba.size());
+  for (int y = 0; y < 2 * height; ++y)
+    for (int x = 0; x < 2 * width; ++x)
+      std::copy_n(&rgba[4 * (static_cast<size_t>(y / 2) * width + x / 2)], 4,
+        &doubled[4 * (static_cast<size_t>(y) * 2 * width + x)]);
+  int size[2] = { 2 * width, 2 * height };
+  helper->RenderTexture(vol, ren, size, size, size, origin, depth, doubled.data());
 }
 
 void vtkMultiMaterialVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)

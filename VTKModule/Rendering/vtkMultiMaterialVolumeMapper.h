@@ -432,6 +432,7 @@ private:
   void UpdateDescription(const InputState& now);
   void UpdateMaterials(const InputState& now);
   void UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now);
+  void TakeFilm(const InputState& now);
   void UpdateRenderer();
   const mmrtm::Film* Refine(bool restart);
   void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);

@@ -254,6 +254,8 @@ CameraView Scene::BuildCamera() const {
   v.orthoHalfHeight = c.orthoHeight > 0.f ? 0.5f * c.orthoHeight : radius / std::max(c.zoom, 1e-3f);
   v.lensRadius = c.lensRadius;
   v.focusDistance = c.focusDistance > 0.f ? c.focusDistance : Length(lookAt - position);
+  v.windowCenterX = c.windowCenter[0];
+  v.windowCenterY = c.windowCenter[1];
   return v;
 }
 

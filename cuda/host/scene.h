@@ -52,10 +52,11 @@ struct CameraDesc {
   float azimuth = 0.f, elevation = 0.f, zoom = 1.f;
   // Explicit placement (autoFrame false).
   Vec3 position, lookAt, up{0.f, 0.f, 1.f};
-  float fovY = 30.f;          // degrees, perspective
-  float orthoHeight = 0.f;    // world units, orthographic; 0 fits the volume
-  float lensRadius = 0.f;     // world units; 0 is a pinhole
-  float focusDistance = 0.f;  // world units; 0 focuses on the look-at point
+  float fovY = 30.f;                   // degrees, perspective
+  float orthoHeight = 0.f;             // world units, orthographic; 0 fits the volume
+  float lensRadius = 0.f;              // world units; 0 is a pinhole
+  float focusDistance = 0.f;           // world units; 0 focuses on the look-at point
+  float windowCenter[2] = {0.f, 0.f};  // CameraView::windowCenterX/Y (VTK's camera sets it)
 };
 
 // Which majorants the trackers use (MajorantKind), and how the grid is laid

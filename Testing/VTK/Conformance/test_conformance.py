@@ -158,6 +158,12 @@ def colour_difference(a, b):
     return sum(diffs) / len(diffs) if diffs else 0.0
 
 
+def mean_colour(pixels):
+    """The mean (r, g, b) over the covered pixels."""
+    kept = [p for p, c in zip(pixels, covered(pixels)) if c]
+    return [sum(p[c] for p in kept) / max(1, len(kept)) for c in range(3)]
+
+
 def coverage(pixels):
     return sum(covered(pixels)) / float(len(pixels))
 
@@ -324,17 +330,22 @@ class ConformanceTest(unittest.TestCase):
                                  "row agree and update Documentation/vtk-mapper.md")
 
         # A magnified screenshot (vtkWindowToImageFilter::SetScale, as
-        # Slicer's Screen Capture takes) against a render at that size.
+        # Slicer's Screen Capture takes; rendered as 2 x 2 tiles) against
+        # a render at that size.
         large = {kind: Render(kind, size=2 * SIZE).pixels() for kind in MAPPERS}
         scaled = {kind: Render(kind, scale=2).pixels() for kind in MAPPERS}
-        effects = {kind: iou(scaled[kind], large[kind]) > 0.85 for kind in MAPPERS}
+        effects = {kind: iou(scaled[kind], large[kind]) > 0.9 for kind in MAPPERS}
         rows.append(self.row("magnified screenshot (SetScale(2))", scaled["ours"], scaled["gpu"],
-                             scaled["fixed-point"], "differs: the magnified image repeats zoomed copies (tiles "
-                             "ignored)", effects))
-        for kind in ("gpu", "fixed-point"):
-            self.assertTrue(effects[kind], "VTK's %s mapper: a magnified screenshot is the large render" % kind)
-        self.assertFalse(effects["ours"], "magnified screenshots: the documented difference no longer holds; "
-                         "make the row agree and update Documentation/vtk-mapper.md")
+                             scaled["fixed-point"], "agrees", effects))
+        print("magnified screenshot: mean colour %s, of the large render %s" % (
+            ["%.1f" % c for c in mean_colour(scaled["ours"])], ["%.1f" % c for c in mean_colour(large["ours"])]))
+        for kind in MAPPERS:
+            self.assertTrue(effects[kind], "%s mapper: a magnified screenshot is the large render" % kind)
+        self.assertGreater(iou(scaled["ours"], scaled["gpu"]), 0.85, "magnified screenshots: ours against VTK's GPU")
+        # Per pixel the two differ by their noise (8 samples); their mean
+        # colours differ when tiles miss samples or light.
+        self.assertLess(max(abs(a - b) for a, b in zip(mean_colour(scaled["ours"]), mean_colour(large["ours"]))), 3,
+                        "magnified screenshots: the mean colour of our large render")
 
         table = ["| feature | IoU with VTK's GPU mapper | colour difference dC (0-255) | VTK's fixed-point vs GPU IoU "
                  "| status |", "|---|---|---|---|---|"]

@@ -17,12 +17,16 @@ struct CameraView {
   float orthoHalfHeight = 1.f;  // orthographic: half the view height in world units
   float lensRadius = 0.f;       // thin lens; 0 is a pinhole
   float focusDistance = 1.f;    // distance of the plane in focus along forward
+  // The centre of the film in the view window, in units of half its width
+  // and height (vtkCamera::WindowCenter): (0, 0) centres the film on the
+  // view direction; a tile of a magnified screenshot sees its own part.
+  float windowCenterX = 0.f, windowCenterY = 0.f;
 
   // Ray through film position (px, py) in pixels, y down; (u0, u1) on the lens.
   MMRTM_CPU_GPU Ray GenerateRay(float px, float py, float u0, float u1) const {
     float aspect = (float)width / (float)height;
-    float sx = (2.f * px / width - 1.f) * aspect;  // [-aspect, aspect]
-    float sy = 1.f - 2.f * py / height;            // [-1, 1], up positive
+    float sx = (2.f * px / width - 1.f + windowCenterX) * aspect;  // [-aspect, aspect] when centred
+    float sy = 1.f - 2.f * py / height + windowCenterY;            // [-1, 1], up positive
     Ray ray;
     if (projection == Projection::Orthographic) {
       ray.o = position + right * (sx * orthoHalfHeight) + up * (sy * orthoHalfHeight);
