@@ -238,6 +238,46 @@ def air_visible(r):
     r.volume.GetProperty().GetScalarOpacity().AddPoint(0, 0.5)
 
 
+def head_labels(image):
+    """A label map on the head's grid: 2 on the half x >= the middle, 1 on
+    the top third of the other half, 0 elsewhere (unsigned char)."""
+    from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    nx, ny, nz = image.GetDimensions()
+    row = bytes([0] * (nx // 2) + [2] * (nx - nx // 2))
+    top = bytes([1] * (nx // 2) + [2] * (nx - nx // 2))
+    values = b"".join((top if k >= 2 * nz // 3 else row) * ny for k in range(nz))
+    array = vtkUnsignedCharArray()
+    array.SetNumberOfTuples(len(values))
+    for i, v in enumerate(values):
+        array.SetValue(i, v)
+    mask = vtkImageData()
+    mask.CopyStructure(image)
+    mask.GetPointData().SetScalars(array)
+    return mask
+
+
+def label_map(r):
+    """Label 2 shows only the bone, in blue; label 1's opacity is 0: both
+    hide the skin over them, as VTK's label functions replace the volume's."""
+    r.reader.Update()
+    r.mask = head_labels(r.reader.GetOutput())
+    r.mapper.SetMaskInput(r.mask)
+    r.mapper.SetMaskTypeToLabelMap()
+    prop = r.volume.GetProperty()
+    bone = vtkPiecewiseFunction()
+    for x, a in ((0, 0.0), (1200, 0.0), (1500, 0.6), (3926, 0.8)):
+        bone.AddPoint(x, a)
+    blue = vtkColorTransferFunction()
+    blue.AddRGBPoint(0, 0.3, 0.5, 1.0)
+    prop.SetLabelScalarOpacity(2, bone)
+    prop.SetLabelColor(2, blue)
+    nothing = vtkPiecewiseFunction()
+    nothing.AddPoint(0, 0.0)
+    nothing.AddPoint(3926, 0.0)
+    prop.SetLabelScalarOpacity(1, nothing)
+
+
 def fewer_pixels(plain, image):
     return coverage(image) < 0.9 * coverage(plain)
 
@@ -292,6 +332,11 @@ CASES = [
     Case("blend mode: additive", blend(vtkVolumeMapper.ADDITIVE_BLEND), None, changed, COMPOSITE_ONLY, ("gpu",)),
     Case("blend mode: isosurface", blend(vtkVolumeMapper.ISOSURFACE_BLEND), None, changed, COMPOSITE_ONLY,
          fixed_point=False),
+    # Labels whose opacity is 0 over the skin are empty there (VTK does not
+    # fall back to the volume's functions): the skin of half the head goes.
+    # Falling back gave the plain silhouette (coverage 0.210 of 0.211) and
+    # IoU 0.73. VTK's fixed-point mapper has no label maps.
+    Case("label map: a label's functions alone", label_map, 0.85, fewer_pixels, fixed_point=False),
 ]
 
 
