@@ -405,7 +405,20 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
       own.gradientRange = proxies.componentGradientRanges[c];
       MaterialDesc m =
         MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c, &proxies.componentRanges[c]);
-      m.base[QuantityOffset(Quantity::Density)] = (float)std::max(property->GetComponentWeight(c), 0.0);
+      // VTK's GPU mapper composites a sample of independent components as
+      // premultiplied colour sum(w_i a_i c_i) over opacity
+      // sum(a_i^2) / sum(w_i a_i) (vtkVolumeShaderComposer.h): a component
+      // alone has opacity a / w and colour w^2 c, so where it is opaque the
+      // weight scales its colour by w^2 and its coverage hardly changes.
+      // Ours keeps the component's extinction and scales its albedo by
+      // w^2; weight 0 removes it, as VTK drops it where it is alone (VTK's
+      // opacity a / w grows without bound below that). vtkVolumeProperty
+      // clamps weights to [0, 1]; NaN stays NaN, counted by
+      // ReplaceNonFinite (the component then holds nothing).
+      const double w = property->GetComponentWeight(c);
+      m.base[QuantityOffset(Quantity::Density)] = std::isnan(w) ? NAN : w > 0.0 ? 1.f : 0.f;
+      for (int k = 0; k < 3; ++k)
+        m.base[QuantityOffset(Quantity::Albedo) + k] = std::isnan(w) ? 0.f : (float)(w * w);
       scene.materials.push_back(std::move(m));
     }
     scene.additiveMaterials = true;

@@ -13,9 +13,10 @@
 //   merge rule "coefficients from several proxies multiply".
 // - Independent components (IndependentComponents on, 2 to 4 components):
 //   each component is a material over its own proxy with its own functions,
-//   its extinction times the component weight, and the materials are mixed
-//   additively (extinctions add, colours weighted by extinction), as VTK
-//   mixes independent components.
+//   its albedo times the square of the component weight (VTK's GPU mapper
+//   scales an opaque component's colour so; weight 0 removes it), and the
+//   materials are mixed additively (extinctions add, colours weighted by
+//   extinction), as VTK mixes independent components.
 // - Colour becomes the albedo; gradient opacity g(|grad x|) multiplies
 //   sigma_t through a gradient-magnitude proxy (made only when used).
 // - The functions are sampled at kTableSize points over the scalar range, as
