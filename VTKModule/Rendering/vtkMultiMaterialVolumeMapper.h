@@ -429,6 +429,7 @@ private:
   // The phases of Render, in order.
   bool ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4]);
   InputState ReadInputs(vtkRenderer* ren, vtkVolume* vol, const int viewport[4]);
+  void ReadTracedImage(InputState& now); // the input as the tracer's image (part of ReadInputs)
   Changes ChangesSince(const InputState& built, const InputState& now);
   void UpdateProxies(const InputState& now);
   void UpdateDescription(const InputState& now);

@@ -16,12 +16,15 @@ documented difference that silently changed.
 Runs with either VTK flavour (Debian 9.1 under Xvfb; the 9.6 wheel), under
 Testing/headless.sh, through Testing/run_unittest.py.
 """
+import math
 import os
 import unittest
 
-from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction, vtkPlane
+from vtkmodules.vtkCommonCore import vtkDoubleArray
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction, vtkPlane, vtkRectilinearGrid
+from vtkmodules.vtkCommonExecutionModel import vtkTrivialProducer
 from vtkmodules.vtkCommonTransforms import vtkTransform
-from vtkmodules.vtkImagingCore import vtkImageAppendComponents, vtkImageCast, vtkImageShiftScale
+from vtkmodules.vtkImagingCore import vtkExtractVOI, vtkImageAppendComponents, vtkImageCast, vtkImageShiftScale
 from vtkmodules.vtkIOImage import vtkNrrdReader
 from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow, vtkVolume,
                                          vtkVolumeProperty, vtkWindowToImageFilter)
@@ -319,6 +322,62 @@ def darker(base, image):
     return mean_green(image) < 0.5 * mean_green(base)
 
 
+def as_data(r, data):
+    """`data` as the mapper's input (through a producer, as Render connects it)."""
+    producer = vtkTrivialProducer()
+    producer.SetOutput(data)
+    r.source, r.data = producer, data
+
+
+def head_image(r):
+    r.reader.Update()
+    return r.reader.GetOutput()
+
+
+def cell_scalars(r):
+    """The head's values as the cell scalars of an image one point larger
+    along each axis, its cell centres on the head's points."""
+    image = head_image(r)
+    s, o, d = image.GetSpacing(), image.GetOrigin(), image.GetDimensions()
+    cells = vtkImageData()
+    cells.SetDimensions(d[0] + 1, d[1] + 1, d[2] + 1)
+    cells.SetSpacing(s)
+    cells.SetOrigin(o[0] - 0.5 * s[0], o[1] - 0.5 * s[1], o[2] - 0.5 * s[2])
+    cells.GetCellData().SetScalars(image.GetPointData().GetScalars())
+    as_data(r, cells)
+
+
+def rectilinear_grid(r):
+    """The head's values on a vtkRectilinearGrid whose x coordinates are
+    finer in the middle (|2t - 1|^1.5 from the centre), y and z uniform."""
+    image = head_image(r)
+    s, o, d = image.GetSpacing(), image.GetOrigin(), image.GetDimensions()
+    grid = vtkRectilinearGrid()
+    grid.SetDimensions(d)
+    for axis, setter in enumerate((grid.SetXCoordinates, grid.SetYCoordinates, grid.SetZCoordinates)):
+        coordinates = vtkDoubleArray()
+        for i in range(d[axis]):
+            t = i / (d[axis] - 1.0)
+            if axis == 0:
+                t = 0.5 + 0.5 * math.copysign(abs(2 * t - 1) ** 1.5, 2 * t - 1)
+            coordinates.InsertNextValue(o[axis] + s[axis] * (d[axis] - 1) * t)
+        setter(coordinates)
+    grid.GetPointData().SetScalars(image.GetPointData().GetScalars())
+    as_data(r, grid)
+
+
+def nan_voxel(r):
+    """The head as float with one NaN voxel in the middle."""
+    cast = vtkImageCast()
+    cast.SetInputData(head_image(r))
+    cast.SetOutputScalarTypeToFloat()
+    cast.Update()
+    image = cast.GetOutput()
+    d = image.GetDimensions()
+    image.GetPointData().GetScalars().SetValue(d[0] // 2 + d[0] * (d[1] // 2 + d[1] * (d[2] // 2)), float("nan"))
+    as_data(r, image)
+
+
 def fewer_pixels(plain, image):
     return coverage(image) < 0.9 * coverage(plain)
 
@@ -384,6 +443,12 @@ CASES = [
     # extinction gave 174 of 176 here.
     Case("independent components: weight 0.5", two_components(0.5), 0.85, darker, effect_on=("gpu", "ours"),
          baseline=two_components(1.0)),
+    # Inputs VTK renders that ours refused (no image: IoU 0). VTK's
+    # fixed-point mapper crashes on cell scalars and takes no rectilinear
+    # grid.
+    Case("cell scalars", cell_scalars, 0.85, same_silhouette, fixed_point=False),
+    Case("vtkRectilinearGrid input (resampled)", rectilinear_grid, 0.85, fixed_point=False),
+    Case("one NaN voxel (rendered as the least value)", nan_voxel, 0.85, same_silhouette),
 ]
 
 
@@ -436,6 +501,27 @@ class ConformanceTest(unittest.TestCase):
             with open(path, "w") as out:
                 out.write("\n".join(table) + "\n")
         print("\n".join(table))
+
+    def test_a_single_slice_is_a_slab(self):
+        """A single slice (64 x 1 x 93, seen face on) renders as a slab one
+        voxel thick, without an error. VTK's two mappers render nothing here
+        (coverage 0), so this is ours alone: catches the refusal ("at least
+        2 voxels along every axis", no image) that it replaced."""
+        from vtkmodules.vtkCommonCore import vtkCommand
+        errors = []
+
+        def one_slice(r):
+            voi = vtkExtractVOI()
+            voi.SetInputData(head_image(r))
+            voi.SetVOI(0, 63, 20, 20, 0, 92)
+            voi.Update()
+            as_data(r, voi.GetOutput())
+            r.mapper.AddObserver(vtkCommand.ErrorEvent, lambda *args: errors.append(args))
+
+        coverages = {kind: coverage(Render(kind, one_slice).pixels()) for kind in MAPPERS}
+        print("single slice: coverage %s" % ", ".join("%s %.3f" % kv for kv in coverages.items()))
+        self.assertEqual(errors, [])
+        self.assertGreater(coverages["ours"], 0.1, "the slab shows the slice")
 
     @staticmethod
     def row(name, ours, gpu, fixed_point, status, effects):
