@@ -307,6 +307,15 @@ class ProgressBar {
   int lastPercent_ = -1;
 };
 
+// A loaded volume, after its warning (on stderr) when NaN voxels were
+// replaced (HostVolume::ReplaceNanVoxels): rendered, and said once.
+mmrtm::HostVolume WarnAboutNanVoxels(mmrtm::HostVolume volume) {
+  if (volume.nanVoxelsReplaced > 0)
+    std::fprintf(stderr, "warning: %s: %lld NaN voxel(s), rendered as the volume's least value\n",
+                 volume.Where().c_str(), (long long)volume.nanVoxelsReplaced);
+  return volume;
+}
+
 double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -450,7 +459,7 @@ int Run(const Options& o) {
   mmrtm::SceneInputs inputs;
   inputs.baseDirectory = baseDirectory;
   inputs.loadVolume = [](const std::string& path, const std::string& name, mmrtm::Interpolation interp) {
-    return mmrtm::LoadVolume(path, name, interp);
+    return WarnAboutNanVoxels(mmrtm::LoadVolume(path, name, interp));
   };
   const bool sceneHasScalars = doc.contains("volumes") && doc["volumes"].contains("scalars");
   const std::string input = !o.input.empty() ? o.input : (sceneHasScalars ? "" : mmrtm::DefaultVolumePath());
@@ -458,7 +467,7 @@ int Run(const Options& o) {
     if (!o.quiet) std::fprintf(stderr, "Loading %s\n", input.c_str());
     mmrtm::VolumeLoadOptions load;
     load.series = o.series;
-    inputs.volumes["scalars"] = mmrtm::LoadVolume(input, "scalars", load);
+    inputs.volumes["scalars"] = WarnAboutNanVoxels(mmrtm::LoadVolume(input, "scalars", load));
   } else if (!o.series.empty()) {
     throw mmrtm::InputError("--series needs a DICOM folder as INPUT");
   }
@@ -472,7 +481,7 @@ int Run(const Options& o) {
   }
   if (!o.labels.empty()) {
     if (!o.quiet) std::fprintf(stderr, "Loading labels %s\n", o.labels.c_str());
-    inputs.volumes["labels"] = mmrtm::LoadVolume(o.labels, "labels", mmrtm::Interpolation::Nearest);
+    inputs.volumes["labels"] = WarnAboutNanVoxels(mmrtm::LoadVolume(o.labels, "labels", mmrtm::Interpolation::Nearest));
   }
   const double loadSeconds = SecondsSince(tStart);
   size_t inputVoxelBytes = 0;  // the volumes as read, in their own voxel types

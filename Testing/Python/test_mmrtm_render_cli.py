@@ -305,10 +305,20 @@ class RenderCli(unittest.TestCase):
         self.expect_failure(self.run_render(path), "volume.xyz")
 
     def test_non_finite_volume(self):
+        # NaN voxels render (as the least value) with one warning naming the
+        # file; an infinite voxel is still an error naming it.
         header = "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nendian: little\n\n"
         values = struct.pack("<8f", 0, 1, 2, float("nan"), 4, 5, 6, 7)
         path = self.write("nan.nrrd", header.encode() + values, "wb")
-        self.expect_failure(self.run_render(path), "nan.nrrd", "non-finite")
+        result = self.run_render(path, "--spp", "1", "--width", "16", "--height", "16")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(result.stderr.count("warning: "), 1, result.stderr)
+        self.assertIn("nan.nrrd: 1 NaN voxel", result.stderr)
+        self.assertTrue(os.path.exists(self.png))
+        os.remove(self.png)
+        values = struct.pack("<8f", 0, 1, 2, float("inf"), 4, 5, 6, 7)
+        path = self.write("inf.nrrd", header.encode() + values, "wb")
+        self.expect_failure(self.run_render(path), "inf.nrrd", "non-finite")
 
     def test_truncated_volume(self):
         with open(HEADSQ, "rb") as f:

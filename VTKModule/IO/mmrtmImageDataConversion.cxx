@@ -66,6 +66,7 @@ HostVolume ImageDataToHostVolume(
     }
   }
   out.indexToWorld = VtkImageIndexToWorld(image);
+  out.ReplaceNanVoxels(); // the caller warns (nanVoxelsReplaced)
   out.Validate();
   return out;
 }

@@ -105,6 +105,7 @@ HostVolume LoadVolume(const std::string& path, const std::string& name, const Vo
   {
     throw InputError(path + ": " + e.what());
   }
+  volume.ReplaceNanVoxels(); // the caller warns (nanVoxelsReplaced)
   volume.Validate();
   return volume;
 }

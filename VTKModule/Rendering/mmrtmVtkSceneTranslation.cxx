@@ -382,6 +382,10 @@ void Add2DMaterials(
 namespace
 {
 
+// The density factor that keeps the other materials off the labels that
+// have functions (TranslateMaterials).
+const char* const kLabelGate = "label map: labels with functions";
+
 // Returns how many function node values were not finite.
 int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
 {
@@ -401,7 +405,20 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
       own.gradientRange = proxies.componentGradientRanges[c];
       MaterialDesc m =
         MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c, &proxies.componentRanges[c]);
-      m.base[QuantityOffset(Quantity::Density)] = (float)std::max(property->GetComponentWeight(c), 0.0);
+      // VTK's GPU mapper composites a sample of independent components as
+      // premultiplied colour sum(w_i a_i c_i) over opacity
+      // sum(a_i^2) / sum(w_i a_i) (vtkVolumeShaderComposer.h): a component
+      // alone has opacity a / w and colour w^2 c, so where it is opaque the
+      // weight scales its colour by w^2 and its coverage hardly changes.
+      // Ours keeps the component's extinction and scales its albedo by
+      // w^2; weight 0 removes it, as VTK drops it where it is alone (VTK's
+      // opacity a / w grows without bound below that). vtkVolumeProperty
+      // clamps weights to [0, 1]; NaN stays NaN, counted by
+      // ReplaceNonFinite (the component then holds nothing).
+      const double w = property->GetComponentWeight(c);
+      m.base[QuantityOffset(Quantity::Density)] = std::isnan(w) ? NAN : w > 0.0 ? 1.f : 0.f;
+      for (int k = 0; k < 3; ++k)
+        m.base[QuantityOffset(Quantity::Albedo) + k] = std::isnan(w) ? 0.f : (float)(w * w);
       scene.materials.push_back(std::move(m));
     }
     scene.additiveMaterials = true;
@@ -445,6 +462,30 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
   }
   if (selector.keys.empty())
     return finite.replaced;
+  // VTK's GPU mapper classifies a labelled voxel by its label's functions
+  // alone: where the label's opacity is 0 the voxel is empty, it does not
+  // fall back to the component's functions. The classifier's priority rule
+  // falls back (the label wins only where its density is above zero), so
+  // the materials that are not labels' are gated off the labels that have
+  // functions: a density factor over the label map, 0 at those labels and
+  // 1 at every other value (0, and labels without functions, which VTK
+  // classifies with the component's functions).
+  TransferFunctionDesc gate;
+  gate.where = kLabelGate;
+  gate.type = TFType::CPCTF;
+  gate.proxy = proxies.labels;
+  gate.channels = 1;
+  for (float label : selector.keys)
+  {
+    gate.keys.insert(gate.keys.end(), { label - 0.5f, label + 0.5f });
+    gate.values.push_back(0.f);
+  }
+  gate.keys.insert(gate.keys.end(), { -kInfinity, kInfinity }); // the first matching range wins
+  gate.values.push_back(1.f);
+  scene.tfs.push_back(std::move(gate));
+  const int firstLabelMaterial = selector.materials.front();
+  for (int m = 0; m < firstLabelMaterial; ++m)
+    scene.materials[m].bindings.push_back({ (int)scene.tfs.size() - 1, Quantity::Density });
   scene.tfs.push_back(std::move(selector));
   scene.selectors.insert(scene.selectors.begin(), (int)scene.tfs.size() - 1); // labels first
   return finite.replaced;
@@ -489,6 +530,18 @@ void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property,
   for (int c = 0; c < 3; ++c)
     m.base[QuantityOffset(Quantity::Albedo) + c] = rule["albedo"][c].get<float>();
   ApplyShading(property, component, m);
+  // A look follows the one label rule (a hidden label shows the volume
+  // property): the label leaves the gate that VTK's label functions put it
+  // in.
+  for (TransferFunctionDesc& gate : scene.tfs)
+    if (gate.where == kLabelGate)
+      for (size_t i = 0; i + 1 < gate.values.size(); ++i)
+        if (gate.keys[2 * i] == label - 0.5f)
+        {
+          gate.keys.erase(gate.keys.begin() + 2 * i, gate.keys.begin() + 2 * i + 2);
+          gate.values.erase(gate.values.begin() + i);
+          break;
+        }
   if (const int index = scene.MaterialIndex(m.name); index >= 0)
   {
     scene.materials[index] = std::move(m); // the property's label functions made it: the selector has it

@@ -13,9 +13,10 @@
 //   merge rule "coefficients from several proxies multiply".
 // - Independent components (IndependentComponents on, 2 to 4 components):
 //   each component is a material over its own proxy with its own functions,
-//   its extinction times the component weight, and the materials are mixed
-//   additively (extinctions add, colours weighted by extinction), as VTK
-//   mixes independent components.
+//   its albedo times the square of the component weight (VTK's GPU mapper
+//   scales an opaque component's colour so; weight 0 removes it), and the
+//   materials are mixed additively (extinctions add, colours weighted by
+//   extinction), as VTK mixes independent components.
 // - Colour becomes the albedo; gradient opacity g(|grad x|) multiplies
 //   sigma_t through a gradient-magnitude proxy (made only when used).
 // - The functions are sampled at kTableSize points over the scalar range, as
@@ -85,8 +86,12 @@ struct ProxyLayout
 // Replaces the scene's TFs, materials and selectors with those of the
 // property's component `component`: one material from its functions (the
 // default material), and with a label map one material per label that has
-// functions of its own, chosen by an MDPTF over the labels (a label's
-// material wins where its opacity is above zero, DESIGN.md's priority rule).
+// functions of its own, chosen by an MDPTF over the labels. As in VTK's GPU
+// mapper, such a label is classified by its own functions alone (a function
+// it lacks is the component's): where its opacity is 0 it is empty, the
+// component's functions do not show through (the default material is gated
+// off those labels). Label 0 and labels without functions take the
+// component's functions.
 // Values that are not finite are read as 0: a NaN node value of a transfer
 // function is 0 at its node (its neighbours still ramp to it; a node at a
 // NaN position is dropped), any other NaN reaching the scene (a component
@@ -98,6 +103,8 @@ int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const P
 // (LabelMaterial: density and albedo), shaded as the property's component
 // `component` is, without gradient opacity: in place of the material that
 // the property's label functions made, else added to the label selector.
+// Where the look's density is 0 (hidden) the property's component
+// functions show, as for a label without a look.
 // Throws InputError for a look out of range.
 void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
   const ProxyLayout& proxies, Scene& scene);

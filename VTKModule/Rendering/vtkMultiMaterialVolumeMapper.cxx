@@ -28,6 +28,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkPointData.h>
+#include <vtkRectilinearGrid.h>
 #include <vtkTexture.h>
 #include <vtkTimeStamp.h>
 #include <vtkSmartPointer.h>
@@ -39,6 +40,7 @@
 #include "label_alignment.h"
 #include "label_materials.h"
 #include "mmrtmImageDataConversion.h"
+#include "mmrtmTracedImage.h"
 #include "mmrtmVolumePropertyFunctions.h"
 #include "mmrtmVtkSceneTranslation.h"
 #include "mmrtm/planted_defect.h"
@@ -167,6 +169,18 @@ struct vtkMultiMaterialVolumeMapper::Internals
     held = cause;
     return say;
   }
+
+  // The last input converted for the tracer (ReadTracedImage), with what
+  // it was converted from.
+  struct Conversion
+  {
+    vtkDataSet* Input = nullptr;
+    vtkMTimeType InputTime = 0;
+    vtkDataArray* Scalars = nullptr;
+    vtkMTimeType ScalarsTime = 0;
+    bool Cell = false;
+    mmrtm::TracedImage Traced;
+  } Converted;
 
   // Asynchronous refinement: the pass in flight adds samples to Film on a
   // thread of its own while renders draw Shown (Film as of the last pass
@@ -710,7 +724,7 @@ bool vtkMultiMaterialVolumeMapper::ValidateInputs(vtkRenderer* ren, vtkVolume* v
   Internals& in = *this->Internal;
   if (!this->GetInput() || !vol->GetProperty())
   {
-    vtkErrorMacro("Render: no input image or no volume property");
+    vtkErrorMacro("Render: " << (this->GetInput() ? "the vtkVolume has no volume property" : "no input"));
     return false;
   }
   if (in.Warn("blend mode", this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND))
@@ -727,19 +741,11 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   // The input brought up to date (a new or modified input rebuilds).
   this->GetInputAlgorithm()->UpdateInformation();
   this->GetInputAlgorithm()->Update();
-  now.Proxies.Data = vtkImageData::SafeDownCast(this->GetInput());
-  if (!now.Proxies.Data)
-    throw mmrtm::InputError("the input is not a vtkImageData");
-  now.Proxies.DataTime = now.Proxies.Data->GetMTime();
+  this->ReadTracedImage(now);
   now.Proxies.Mask = in.Mask;
   now.Proxies.MaskTime = in.Mask ? in.Mask->GetMTime() : 0;
   now.Proxies.MaskType = this->MaskType;
   now.Proxies.MultiMaterial = in.MultiMaterial;
-  int cellFlag = 0;
-  now.Proxies.Scalars = vtkAbstractMapper::GetScalars(
-    now.Proxies.Data, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
-  if (!now.Proxies.Scalars || cellFlag)
-    throw mmrtm::InputError("the input needs point scalars");
 
   // The proxies the property asks for.
   vtkVolumeProperty* property = vol->GetProperty();
@@ -783,6 +789,40 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   return now;
 }
 
+void vtkMultiMaterialVolumeMapper::ReadTracedImage(InputState& now)
+{
+  // The input as the tracer's image (mmrtmTracedImage.h), converted again
+  // only when the input, its scalars or their modification times changed,
+  // so that an unchanged input does not rebuild.
+  Internals& in = *this->Internal;
+  vtkDataSet* input = this->GetInput();
+  int cellFlag = 0;
+  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
+    input, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+  if (!scalars)
+    throw mmrtm::InputError(
+      std::string("the input (a ") + input->GetClassName() + ") has no scalars for the mapper's scalar mode");
+  Internals::Conversion& c = in.Converted;
+  const vtkMTimeType inputTime = input->GetMTime(), scalarsTime = scalars->GetMTime();
+  if (c.Input != input || c.InputTime != inputTime || c.Scalars != scalars || c.ScalarsTime != scalarsTime ||
+    c.Cell != (cellFlag != 0))
+  {
+    c = Internals::Conversion{};
+    c.Traced = mmrtm::ImageForTracing(input, scalars, cellFlag != 0);
+    c.Input = input;
+    c.InputTime = inputTime;
+    c.Scalars = scalars;
+    c.ScalarsTime = scalarsTime;
+    c.Cell = cellFlag != 0;
+  }
+  now.Proxies.Data = c.Traced.Image ? c.Traced.Image.Get() : vtkImageData::SafeDownCast(input);
+  now.Proxies.DataTime = inputTime;
+  now.Proxies.Scalars = c.Traced.Image ? c.Traced.Scalars : scalars;
+  const bool resampled = vtkRectilinearGrid::SafeDownCast(input) != nullptr;
+  if (in.Warn("rectilinear grid", resampled))
+    vtkWarningMacro(<< c.Traced.Conversion << " (VTK's GPU mapper samples the grid on its own coordinates)");
+}
+
 vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince(
   const InputState& built, const InputState& now)
 {
@@ -805,6 +845,13 @@ void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
   const bool labels = now.Proxies.Mask && now.Proxies.MaskType == LABELMAP;
   const InputState::ProxyInputs& p = now.Proxies;
   this->BuildProxies(now.Materials.Property, p.Data, p.Scalars, p.Dependent, p.Independent, p.NeedGradient, labels);
+  int64_t nans = 0;
+  for (const mmrtm::HostVolume& v : in.Scene.proxies)
+    nans += v.nanVoxelsReplaced;
+  if (in.Warn("NaN voxels", nans > 0))
+    vtkWarningMacro(<< nans
+                    << " voxel value(s) of the input or mask are NaN; they are rendered as the volume's least "
+                       "value (empty where its opacity is 0)");
   in.LightsFromScene = false;
   if (now.Proxies.MultiMaterial)
     this->ParseMultiMaterialScene();

@@ -220,9 +220,11 @@ public:
    * grid that overlaps it in world space), as in vtkGPUVolumeRayCastMapper.
    * LABELMAP (the default): every label with a colour, scalar-opacity or
    * gradient-opacity function in the volume property (SetLabelColor, ...)
-   * becomes a material of its own, chosen where the mask has that label and
-   * its opacity is above zero; elsewhere the property's component-0
-   * functions apply. BINARY: voxels where the mask is 0 are empty.
+   * becomes a material of its own where the mask has that label, as in
+   * VTK's GPU mapper: its functions alone (a function it lacks is
+   * component 0's), so a label whose opacity is 0 is empty; label 0 and
+   * labels without functions take the property's component-0 functions.
+   * BINARY: voxels where the mask is 0 are empty.
    */
   void SetMaskInput(vtkImageData* mask);
   vtkImageData* GetMaskInput();
@@ -427,6 +429,7 @@ private:
   // The phases of Render, in order.
   bool ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4]);
   InputState ReadInputs(vtkRenderer* ren, vtkVolume* vol, const int viewport[4]);
+  void ReadTracedImage(InputState& now); // the input as the tracer's image (part of ReadInputs)
   Changes ChangesSince(const InputState& built, const InputState& now);
   void UpdateProxies(const InputState& now);
   void UpdateDescription(const InputState& now);

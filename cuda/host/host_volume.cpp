@@ -96,6 +96,24 @@ Vec3 HostVolume::WorldCenter() const {
   return indexToWorld.ApplyPoint({0.5f * (dims[0] - 1), 0.5f * (dims[1] - 1), 0.5f * (dims[2] - 1)});
 }
 
+void HostVolume::ReplaceNanVoxels() {
+  if (type != VoxelType::Float32) return;
+  float* f = reinterpret_cast<float*>(voxels.data());
+  const int64_t n = std::min<int64_t>(VoxelCount(), (int64_t)(voxels.size() / sizeof(float)));
+  float least = std::numeric_limits<float>::infinity();
+  int64_t nans = 0;
+  for (int64_t i = 0; i < n; ++i)
+    if (std::isnan(f[i]))
+      ++nans;
+    else if (std::isfinite(f[i]))
+      least = std::min(least, f[i]);
+  if (nans == 0) return;
+  if (!std::isfinite(least)) least = 0.f;
+  for (int64_t i = 0; i < n; ++i)
+    if (std::isnan(f[i])) f[i] = least;
+  nanVoxelsReplaced += nans;
+}
+
 void HostVolume::Validate() const {
   const std::string where = source.empty() ? name : source;
   for (int a = 0; a < 3; ++a)

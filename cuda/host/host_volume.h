@@ -40,6 +40,15 @@ struct HostVolume {
   // Checks dims, buffer size and (for float voxels) finiteness; throws
   // InputError naming `source` and the problem.
   void Validate() const;
+
+  // Float voxels that are NaN (a hole in a simulation, a failed
+  // reconstruction) set to the least finite voxel value (0 when there is
+  // none), so that they are as empty as the emptiest voxel under a transfer
+  // function that is 0 there (air, background), and interpolation next to
+  // them stays finite. Adds their number to nanVoxelsReplaced, for the
+  // caller to warn about. Infinite voxels are left (Validate rejects them).
+  void ReplaceNanVoxels();
+  int64_t nanVoxelsReplaced = 0;
 };
 
 // Whether `v` lies on the voxel grid of `grid`: the same dimensions and the
