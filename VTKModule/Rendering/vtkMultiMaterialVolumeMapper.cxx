@@ -1,6 +1,8 @@
 #include "vtkMultiMaterialVolumeMapper.h"
 
 #include <algorithm>
+#include <array>
+#include <cfloat>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -581,6 +583,8 @@ bool vtkMultiMaterialVolumeMapper::IsConverged()
   const int accumulated = static_cast<int>(film->Samples());
   if (this->MaximumSamples > 0 && accumulated >= this->MaximumSamples)
     return true;
+  if (accumulated >= 1 && this->Internal->Scene.render.integrator.projection.mode != mmrtm::IntensityProjection::None)
+    return true; // a projection's one sample is its image
   // The noise estimate needs two samples; it costs one pass over the film.
   return this->NoiseTarget > 0 && accumulated >= 2 && film->Noise().relative <= this->NoiseTarget;
 }
@@ -727,8 +731,8 @@ bool vtkMultiMaterialVolumeMapper::ValidateInputs(vtkRenderer* ren, vtkVolume* v
     vtkErrorMacro("Render: " << (this->GetInput() ? "the vtkVolume has no volume property" : "no input"));
     return false;
   }
-  if (in.Warn("blend mode", this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND))
-    vtkWarningMacro("only composite blending is supported; rendering as composite");
+  if (in.Warn("blend mode", this->BlendMode == vtkVolumeMapper::ISOSURFACE_BLEND))
+    vtkWarningMacro("isosurface blending is not supported; rendering as composite");
   ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
   return viewport[0] > 0 && viewport[1] > 0;
 }
@@ -923,6 +927,7 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
     : this->Accelerator == NO_ACCELERATOR              ? mmrtm::MajorantKind::Global
                                                        : mmrtm::MajorantKind::Octree;
   rs.integrator.backgroundVisible = false; // VTK's background shows through
+  rs.integrator.projection = this->Projection(now.Materials.Property);
   this->TakeFilm(now);
   in.Built.View = std::move(now.View);
   in.HasScene = true;
@@ -961,6 +966,50 @@ void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
   in.Shown.reset(); // the image of the view before
 }
 
+mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProperty* property)
+{
+  // VTK's projection blend modes (mmrtm/projection.h), sampled as VTK's GPU
+  // mapper samples them with AutoAdjustSampleDistances on (its default):
+  // at the smallest spacing of the volume in world space.
+  Internals& in = *this->Internal;
+  mmrtm::ProjectionSettings p;
+  switch (this->BlendMode)
+  {
+    case vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND:
+      p.mode = mmrtm::IntensityProjection::Maximum;
+      break;
+    case vtkVolumeMapper::MINIMUM_INTENSITY_BLEND:
+      p.mode = mmrtm::IntensityProjection::Minimum;
+      break;
+    case vtkVolumeMapper::AVERAGE_INTENSITY_BLEND:
+      p.mode = mmrtm::IntensityProjection::Average;
+      break;
+    case vtkVolumeMapper::ADDITIVE_BLEND:
+      p.mode = mmrtm::IntensityProjection::Additive;
+      break;
+    default:
+      return p; // composite (and isosurface, warned about): traced
+  }
+  const mmrtm::HostVolume& volume = in.Scene.proxies.at(0);
+  float step = mmrtm::kInfinity;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const mmrtm::Affine3& m = volume.indexToWorld;
+    step = std::min(
+      step, std::sqrt(m.m[0][axis] * m.m[0][axis] + m.m[1][axis] * m.m[1][axis] + m.m[2][axis] * m.m[2][axis]));
+  }
+  p.step = step > 0.f ? step : 1.f;
+  const double unit = property->GetScalarOpacityUnitDistance(0);
+  p.opacityUnitDistance = unit > 0.0 ? static_cast<float>(unit) : 1.f;
+  const std::array<float, 2> range =
+    in.Layout.scalarRange[1] > in.Layout.scalarRange[0] ? in.Layout.scalarRange : volume.ValueRange();
+  p.valueRange[0] = range[0];
+  p.valueRange[1] = range[1];
+  p.averageRange[0] = static_cast<float>(std::max<double>(this->AverageIPScalarRange[0], -FLT_MAX));
+  p.averageRange[1] = static_cast<float>(std::min<double>(this->AverageIPScalarRange[1], FLT_MAX));
+  return p;
+}
+
 void vtkMultiMaterialVolumeMapper::UpdateRenderer()
 {
   Internals& in = *this->Internal;
@@ -994,10 +1043,11 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
   const int accumulated = static_cast<int>(in.Film->Samples());
   // A tile of a magnified screenshot is drawn once: with as many samples
-  // as the view it magnifies has.
-  const int perRender = in.Built.View.Tile && in.ParkedFilm
-    ? std::max(this->SamplesPerRender, static_cast<int>(in.ParkedFilm->Samples()))
-    : this->SamplesPerRender;
+  // as the view it magnifies has. A projection needs one.
+  const bool projecting = in.Scene.render.integrator.projection.mode != mmrtm::IntensityProjection::None;
+  const int perRender = projecting        ? 1
+    : in.Built.View.Tile && in.ParkedFilm ? std::max(this->SamplesPerRender, static_cast<int>(in.ParkedFilm->Samples()))
+                                          : this->SamplesPerRender;
   const int samples = this->IsConverged() ? 0
     : this->MaximumSamples > 0            ? std::min(perRender, this->MaximumSamples - accumulated)
                                           : perRender;
@@ -1304,8 +1354,11 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
 {
   // The image: tone-mapped, premultiplied RGBA, bottom row first for OpenGL.
   const int width = film.Width(), height = film.Height();
-  std::vector<uint8_t> rgba =
-    film.ToneMapped(static_cast<float>(this->Exposure), this->Internal->Scene.render.toneMapper, 4);
+  // A projection's film holds VTK's colours made linear: no curve.
+  const mmrtm::RenderSettings& rs = this->Internal->Scene.render;
+  const mmrtm::ToneMapper toneMapper =
+    rs.integrator.projection.mode != mmrtm::IntensityProjection::None ? mmrtm::ToneMapper::Clamp : rs.toneMapper;
+  std::vector<uint8_t> rgba = film.ToneMapped(static_cast<float>(this->Exposure), toneMapper, 4);
   const size_t row = 4 * static_cast<size_t>(width);
   for (int y = 0; y < height / 2; ++y)
     std::swap_ranges(rgba.begin() + y * row, rgba.begin() + (y + 1) * row, rgba.begin() + (height - 1 - y) * row);

@@ -54,6 +54,7 @@ namespace mmrtm
 {
 class Film;
 struct ClipPlane;
+struct ProjectionSettings;
 }
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper
@@ -437,6 +438,7 @@ private:
   void UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now);
   void TakeFilm(const InputState& now);
   void UpdateRenderer();
+  mmrtm::ProjectionSettings Projection(vtkVolumeProperty* property);
   const mmrtm::Film* Refine(bool restart);
   void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);

@@ -239,7 +239,22 @@ def blend(mode):
             r.volume.GetProperty().GetIsoSurfaceValues().SetValue(0, 1300)
         if mode == vtkVolumeMapper.MINIMUM_INTENSITY_BLEND:
             air_visible(r)
+        if mode == vtkVolumeMapper.AVERAGE_INTENSITY_BLEND:
+            r.mapper.SetAverageIPScalarRange(600, 4000)  # air left out: a mean that is not near black
+        if mode == vtkVolumeMapper.ADDITIVE_BLEND:
+            faint(r)
     return configure
+
+
+def faint(r):
+    """Opacity a fiftieth of the head's: the additive sum along a ray stays
+    below 1 instead of saturating to white."""
+    opacity = r.volume.GetProperty().GetScalarOpacity()
+    for i in range(opacity.GetSize()):
+        node = [0.0] * 4
+        opacity.GetNodeValue(i, node)
+        node[1] /= 50.0
+        opacity.SetNodeValue(i, node)
 
 
 def air_visible(r):
@@ -407,8 +422,11 @@ class Case:
     (`effect(plain, image)`) and on which mappers' images."""
 
     def __init__(self, name, configure, least_iou, effect=None, difference="", effect_on=None, fixed_point=True,
-                 baseline=None):
+                 baseline=None, most_dc=None):
         self.name, self.configure, self.least_iou, self.effect = name, configure, least_iou, effect
+        # The largest colour difference with VTK's GPU mapper, for rows whose
+        # colours are VTK's by construction (the projections: no light).
+        self.most_dc = most_dc
         self.baseline = baseline  # the render the effect is measured against (None: the plain one)
         self.difference = difference
         self.mappers = MAPPERS if fixed_point else ("gpu", "ours")  # the fixed-point mapper lacks some modes
@@ -429,13 +447,21 @@ CASES = [
     # A wider cross, so that the hole it cuts through the middle shows; what
     # is left are thin pillars (VTK's two mappers agree on them to IoU 0.87).
     Case("cropping: inverted cross", cropping_regions(VTK_CROP_INVERTED_CROSS, half=45), 0.78, changed),
-    Case("blend mode: maximum intensity", blend(vtkVolumeMapper.MAXIMUM_INTENSITY_BLEND), None, changed,
-         COMPOSITE_ONLY),
-    Case("blend mode: minimum intensity", blend(vtkVolumeMapper.MINIMUM_INTENSITY_BLEND), None, changed,
-         COMPOSITE_ONLY, ("gpu",), baseline=air_visible),
-    Case("blend mode: average intensity", blend(vtkVolumeMapper.AVERAGE_INTENSITY_BLEND), None, changed,
-         COMPOSITE_ONLY, fixed_point=False),
-    Case("blend mode: additive", blend(vtkVolumeMapper.ADDITIVE_BLEND), None, changed, COMPOSITE_ONLY, ("gpu",)),
+    # The projections: VTK's colour and opacity of the extreme value, the
+    # mean or the sum along the ray. As composite they were IoU 0.87, 0.95,
+    # 0.29 and 0.91 with dC 52-167.
+    Case("blend mode: maximum intensity", blend(vtkVolumeMapper.MAXIMUM_INTENSITY_BLEND), 0.9, changed,
+         most_dc=5),
+    Case("blend mode: minimum intensity", blend(vtkVolumeMapper.MINIMUM_INTENSITY_BLEND), 0.9, changed,
+         effect_on=("gpu", "ours"), baseline=air_visible, most_dc=5),
+    Case("blend mode: average intensity", blend(vtkVolumeMapper.AVERAGE_INTENSITY_BLEND), 0.9, changed,
+         fixed_point=False, most_dc=5),
+    # The sum depends on how many samples a ray takes: ours steps at the
+    # smallest voxel spacing (1.5 mm here), and VTK's GPU sum is 1.5 times
+    # ours in the bright parts whatever its SampleDistance (1 or 1.5): not
+    # yet explained, so the colours are bounded loosely (dC 15.7 measured).
+    Case("blend mode: additive", blend(vtkVolumeMapper.ADDITIVE_BLEND), 0.9, changed, effect_on=("gpu", "ours"),
+         most_dc=20),
     Case("blend mode: isosurface", blend(vtkVolumeMapper.ISOSURFACE_BLEND), None, changed, COMPOSITE_ONLY,
          fixed_point=False),
     # Labels whose opacity is 0 over the skin are empty there (VTK does not
@@ -482,6 +508,9 @@ class ConformanceTest(unittest.TestCase):
             if case.least_iou is not None:
                 self.assertGreater(iou(images["ours"], images["gpu"]), case.least_iou,
                                    name + ": our silhouette against VTK's GPU mapper's")
+                if case.most_dc is not None:
+                    self.assertLess(colour_difference(images["ours"], images["gpu"]), case.most_dc,
+                                    name + ": our colours against VTK's GPU mapper's")
             elif case.effect:
                 self.assertFalse(effects["ours"], name + ": the documented difference no longer holds; make the "
                                  "row agree and update Documentation/vtk-mapper.md")

@@ -19,6 +19,7 @@
 #include "mmrtm/bsdf.h"
 #include "mmrtm/phase.h"
 #include "mmrtm/planted_defect.h"
+#include "mmrtm/projection.h"
 #include "mmrtm/sobol.h"
 #include "mmrtm/tracking.h"
 
@@ -54,11 +55,6 @@ MMRTM_CPU_GPU inline bool ChooseAndReuse(float p, float* u) {
   *u = Min((*u - p) / (1.f - p), kOneMinusEpsilon);
   return false;
 }
-
-struct PixelSample {
-  RGB L;
-  float alpha = 0.f;  // 1 when the camera ray collided with the volume
-};
 
 // `cameraTMax`: how far the camera ray may go (opaque geometry of the host
 // application in front, e.g. a VTK mesh); beyond it the pixel is not the
@@ -245,9 +241,11 @@ MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, in
     l0 = rng.Uniform();
     l1 = rng.Uniform();
   }
-  Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
   ++ctr.paths;
   const float tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
+  if (s.settings.projection.mode != IntensityProjection::None)  // through the pixel's centre: one sample is the image
+    return ProjectRay(s, s.camera.GenerateRay((float)x + 0.5f, (float)y + 0.5f, 0.5f, 0.5f), tMax, ctr);
+  Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
   return Li(s, ray, rng, ctr, tMax, sobol ? &pairs : nullptr);
 }
 

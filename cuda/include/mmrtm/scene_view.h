@@ -33,6 +33,17 @@ enum class PixelSampler : uint8_t {
                 // first two vertices (the default); the rest from the stream
 };
 
+// VTK's projection blend modes (mmrtm/projection.h); None traces paths.
+enum class IntensityProjection : uint8_t { None, Maximum, Minimum, Average, Additive };
+
+struct ProjectionSettings {
+  IntensityProjection mode = IntensityProjection::None;
+  float step = 1.f;                                 // world units between the samples along a ray
+  float opacityUnitDistance = 1.f;                  // the scalar opacity's unit distance (the translation's)
+  float valueRange[2] = {0.f, 1.f};                 // proxy 0's values mapped to [0, 1] (Average, Additive)
+  float averageRange[2] = {-kInfinity, kInfinity};  // the values Average counts
+};
+
 struct IntegratorSettings {
   Estimator estimator = Estimator::DeltaTracking;
   int maxBounces = 32;           // real scattering events per path
@@ -43,6 +54,7 @@ struct IntegratorSettings {
   LightSampling lightSampling = LightSampling::Resampled;
   PixelSampler sampler = PixelSampler::Sobol;
   uint64_t seed = 0;
+  ProjectionSettings projection;
 };
 
 // A half-space that is kept: points with Dot(normal, p) + offset >= 0 (VTK's
@@ -97,6 +109,13 @@ struct SceneView {
     }
     return *t0 < *t1;
   }
+};
+
+// One sample of a pixel: the radiance, and 1 when the camera ray collided
+// with the volume.
+struct PixelSample {
+  RGB L;
+  float alpha = 0.f;
 };
 
 }  // namespace mmrtm

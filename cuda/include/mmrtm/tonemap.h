@@ -17,6 +17,12 @@ MMRTM_CPU_GPU inline float LinearToSRGB(float v) {
   return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.f / 2.4f) - 0.055f;
 }
 
+// The inverse of LinearToSRGB on [0, 1].
+MMRTM_CPU_GPU inline float SRGBToLinear(float v) {
+  v = Clamp(v, 0.f, 1.f);
+  return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+}
+
 MMRTM_CPU_GPU inline float FilmicCurve(float x) {
   const float a = 2.51f, b = 0.03f, c = 2.43f, d = 0.59f, e = 0.14f;
   return Clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.f, 1.f);
