@@ -216,6 +216,30 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.counts(), (1, 1, 2), "one restart per view")
         self.assertGreater(coverage(s.pixels()), 0.05)
 
+    def test_a_projection_blend_mode_is_one_sample(self):
+        """Maximum intensity is a projection: one sample per pixel through
+        the pixel's centre is the whole image, so the mapper traces one and
+        stops; its image differs from the composite one, and going back to
+        composite restarts the path tracing. Catches a projection traced
+        SamplesPerRender times per render (identical samples), and a blend
+        mode change that does not restart."""
+        s = Scene()
+        s.render()
+        composite = s.pixels()
+        s.mapper.SetBlendModeToMaximumIntensity()
+        for _ in range(3):
+            s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 1)
+        self.assertTrue(s.mapper.IsConverged())
+        self.assertEqual(s.counts(), (1, 1, 2), "the blend mode restarts, nothing else")
+        mip = s.pixels()
+        self.assertGreater(coverage(mip), 0.05)
+        self.assertGreater(mean_abs_difference(composite, mip), 0.01)
+        s.mapper.SetBlendModeToComposite()
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+        self.assertFalse(s.mapper.IsConverged())
+
     def test_transfer_function_change_refits_and_restarts(self):
         s = Scene()
         for _ in range(3):
@@ -612,10 +636,10 @@ class MapperTest(unittest.TestCase):
         def said(text):
             return sum(1 for m in warnings.messages if text in m)
 
-        s.mapper.SetBlendModeToMaximumIntensity()
+        s.mapper.SetBlendModeToIsoSurface()
         s.render()
         s.render()
-        self.assertEqual(said("only composite blending"), 1, warnings.messages)
+        self.assertEqual(said("isosurface blending is not supported"), 1, warnings.messages)
         s.mapper.SetCroppingRegionPlanes(*s.mapper.GetBounds())
         s.mapper.SetCroppingRegionFlagsToFence()
         s.mapper.CroppingOn()
@@ -641,9 +665,9 @@ class MapperTest(unittest.TestCase):
         # A cause that goes away and comes back is said again.
         s.mapper.SetBlendModeToComposite()
         s.render()
-        s.mapper.SetBlendModeToMaximumIntensity()
+        s.mapper.SetBlendModeToIsoSurface()
         s.render()
-        self.assertEqual(said("only composite blending"), 2, warnings.messages)
+        self.assertEqual(said("isosurface blending is not supported"), 2, warnings.messages)
         # More clipping planes than the tracer takes (12): its own warning, once.
         planes = vtkPlaneCollection()
         bounds = s.mapper.GetBounds()
