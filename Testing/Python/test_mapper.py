@@ -376,6 +376,91 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
         self.assertEqual(s.mapper.GetNumberOfInteractiveRenders(), previews)
 
+    def test_depth_peeling_for_volumes_traces_once_per_frame(self):
+        """With the renderer's depth peeling for volumes and a translucent
+        sphere, VTK calls Render once per peel. Catches a frame traced more
+        than once (each call restarting on the depth it read inside the
+        peel: a garbled image), a translucent actor that no longer shows
+        over the volume, and a volume that no longer shows."""
+        s = Scene()
+        s.window.SetMultiSamples(0)  # VTK peels only without multisampling
+        sphere = vtkSphereSource()  # in front of the face, partly over it
+        c = s.volume.GetCenter()
+        sphere.SetCenter(c[0] + 30, -10, c[2])
+        sphere.SetRadius(30)
+        mapper = vtkPolyDataMapper()
+        mapper.SetInputConnection(sphere.GetOutputPort())
+        actor = vtkActor()
+        actor.SetMapper(mapper)
+        actor.GetProperty().SetColor(0.0, 0.0, 1.0)
+        actor.GetProperty().SetOpacity(0.5)
+        s.renderer.AddActor(actor)
+        s.renderer.SetUseDepthPeeling(1)
+        s.renderer.SetUseDepthPeelingForVolumes(1)
+        calls = []
+        s.mapper.AddObserver(vtkCommand.VolumeMapperRenderStartEvent, lambda *args: calls.append(1))
+        for frame in range(1, 4):
+            before = len(calls)
+            s.render()
+            self.assertGreater(len(calls) - before, 1, "VTK peels the volume: Render is called per peel")
+            self.assertEqual(s.mapper.GetNumberOfTracedPasses(), frame, "one traced pass per frame")
+            self.assertEqual(s.mapper.GetAccumulatedSamples(), 2 * frame, "the frames accumulate")
+        self.assertEqual(s.mapper.GetNumberOfRestarts(), 1, "the depth read in the peels is the same each frame")
+        pixels = s.pixels()
+        blue = sum(1 for i in range(0, len(pixels), 3) if pixels[i + 2] > pixels[i] + 40)
+        self.assertGreater(blue, 0.02 * len(pixels) / 3, "the translucent sphere shows (547 of 16384 pixels)")
+        s.renderer.RemoveActor(actor)
+        s.render()
+        self.assertGreater(coverage(s.pixels()), 0.05, "the volume shows")
+
+    def test_image_sample_distance_and_auto_adjust(self):
+        """VTK's ImageSampleDistance and AutoAdjustSampleDistances, counted
+        by film sizes: catches a distance that is ignored (a still film of
+        the viewport's size at distance 2 with AutoAdjust off), a still
+        render that does not go back to full resolution with AutoAdjust on,
+        and a preview that adapts when AutoAdjust is off."""
+        s = Scene()
+        size = [0, 0]
+        s.mapper.SetImageSampleDistance(2.0)
+        s.render()
+        s.mapper.GetLastFilmSize(size)
+        self.assertEqual(size, [128, 128], "AutoAdjust on: a still render at the minimum distance, 1")
+        s.mapper.AutoAdjustSampleDistancesOff()
+        s.render()
+        s.mapper.GetLastFilmSize(size)
+        self.assertEqual(size, [64, 64], "AutoAdjust off: ImageSampleDistance 2 gives a film of half the size")
+        image = vtkImageData()
+        s.mapper.GetAccumulatedImage(image)
+        self.assertEqual(image.GetDimensions()[:2], (64, 64))
+        self.assertGreater(coverage(s.pixels()), 0.05, "the half-size film is stretched over the viewport")
+        s.mapper.SetImageSampleDistance(3.0)
+        s.render()
+        s.mapper.GetLastFilmSize(size)
+        self.assertEqual(size, [43, 43], "a distance that does not divide the viewport rounds up")
+        # Previews at a budget no frame can meet: fixed with AutoAdjust off,
+        # coarser with it on.
+        s.window.SetDesiredUpdateRate(1000.0)
+        sizes = set()
+        for _ in range(4):
+            s.renderer.GetActiveCamera().Azimuth(5)
+            s.render()
+            s.mapper.GetLastFilmSize(size)
+            sizes.add(tuple(size))
+        self.assertEqual(sizes, {(43, 43)}, "AutoAdjust off: the preview keeps ImageSampleDistance")
+        s.mapper.AutoAdjustSampleDistancesOn()
+        s.mapper.SetMaximumImageSampleDistance(8.0)
+        for _ in range(30):
+            s.renderer.GetActiveCamera().Azimuth(5)
+            s.render()
+        s.mapper.GetLastFilmSize(size)
+        self.assertEqual(size, [16, 16], "AutoAdjust on: an impossible budget ends at the maximum distance, 8")
+        self.assertGreater(s.volume.GetAllocatedRenderTime(), 0.0)
+        self.assertLess(s.volume.GetAllocatedRenderTime(), 0.01, "the budget comes from the update rate")
+        s.window.SetDesiredUpdateRate(0.0001)
+        s.render()
+        s.mapper.GetLastFilmSize(size)
+        self.assertEqual(size, [128, 128], "the still render after the interaction is at full resolution")
+
     def test_clipping_and_cropping(self):
         s = Scene()
         s.render()

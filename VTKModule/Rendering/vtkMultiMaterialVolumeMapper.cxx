@@ -13,7 +13,17 @@
 #include <tuple>
 #include <vector>
 
+#include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
+#include <vtkCommand.h>
+#include <vtkInformation.h>
+#include <vtkInformationObjectBaseVectorKey.h>
+#include <vtkOpenGLFramebufferObject.h>
+#include <vtkOpenGLRenderPass.h>
+#include <vtkOpenGLRenderWindow.h>
+#include <vtkOpenGLState.h>
+#include <vtkWeakPointer.h>
+#include <vtk_glew.h>
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
@@ -91,8 +101,9 @@ struct vtkMultiMaterialVolumeMapper::InputState
 
   struct ViewInputs
   {
-    int Width = 0, Height = 0;  // the viewport's
-    std::vector<double> Values; // camera, lights, matrix, size, clipping, environment: SameView
+    int Width = 0, Height = 0;         // the viewport's
+    int FilmWidth = 0, FilmHeight = 0; // the still film's: the viewport's over the image sample distance
+    std::vector<double> Values;        // camera, lights, matrix, size, clipping, environment: SameView
     std::vector<mmrtm::ClipPlane> Clip;
     std::vector<float> Depth; // the depth buffer under the volume
     vtkMTimeType TracingTime = 0;
@@ -211,10 +222,24 @@ struct vtkMultiMaterialVolumeMapper::Internals
   }
   std::string LastExtinctionWarning; // said once per change (vtkWarningMacro)
   double LastBuildSeconds = 0;
-  // While the interactor moves the camera: a preview at 1/PreviewFactor of
-  // the resolution, 1 sample per pixel, the factor adapted to the frame rate.
+  // While the interactor moves the camera: a preview with an image sample
+  // distance of PreviewDistance (1/PreviewDistance of the resolution), 1
+  // sample per pixel, the distance adapted to the volume's allocated time.
   std::unique_ptr<mmrtm::Film> Preview;
-  int PreviewFactor = 4;
+  double PreviewDistance = 4.0;
+  int TracedPasses = 0;
+  int LastFilmSize[2] = { 0, 0 };
+
+  // Depth peeling for volumes calls Render once per peel: each renderer's
+  // StartEvent marks a new frame (Traced false), and the first call of a
+  // frame traces and draws it.
+  struct PeelFrame
+  {
+    vtkWeakPointer<vtkRenderer> Renderer;
+    unsigned long Observer = 0;
+    bool Traced = false;
+  };
+  std::vector<std::unique_ptr<PeelFrame>> PeelFrames;
 };
 
 namespace
@@ -316,6 +341,29 @@ std::vector<float> ReadDepth(vtkRenderer* ren, int width, int height, int x0, in
   return {};
 }
 
+// Pixels of a film over `size` viewport pixels at an image sample distance.
+int FilmSize(int size, double distance)
+{
+  return std::max(1, static_cast<int>(std::ceil(size / distance - 1e-9)));
+}
+
+// The viewport's depth buffer (width x height) at the pixel centres of a
+// film of w x h stretched over it.
+std::vector<float> DepthAtFilmPixels(const std::vector<float>& depth, int width, int height, int w, int h)
+{
+  if (w == width && h == height)
+    return depth;
+  std::vector<float> at(static_cast<size_t>(w) * h);
+  for (int row = 0; row < h; ++row)
+    for (int x = 0; x < w; ++x)
+    {
+      const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / w));
+      const int fy = std::min(height - 1, static_cast<int>((row + 0.5) * height / h));
+      at[static_cast<size_t>(row) * w + x] = depth[static_cast<size_t>(fy) * width + fx];
+    }
+  return at;
+}
+
 // Per pixel (rows top first, as the film): the distance along the camera
 // ray to the geometry in the depth buffer, kInfinity where there is none.
 // Perspective rays start at the camera, orthographic ones in the plane
@@ -391,6 +439,9 @@ vtkMultiMaterialVolumeMapper::vtkMultiMaterialVolumeMapper()
 vtkMultiMaterialVolumeMapper::~vtkMultiMaterialVolumeMapper()
 {
   this->FinishPass(true);
+  for (const auto& frame : this->Internal->PeelFrames)
+    if (vtkRenderer* ren = frame->Renderer)
+      ren->RemoveObserver(frame->Observer);
 }
 
 void vtkMultiMaterialVolumeMapper::FinishPass(bool cancel)
@@ -646,6 +697,17 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfInteractiveRenders()
   return this->Internal->InteractiveRenders;
 }
 
+int vtkMultiMaterialVolumeMapper::GetNumberOfTracedPasses()
+{
+  return this->Internal->TracedPasses;
+}
+
+void vtkMultiMaterialVolumeMapper::GetLastFilmSize(int size[2])
+{
+  size[0] = this->Internal->LastFilmSize[0];
+  size[1] = this->Internal->LastFilmSize[1];
+}
+
 int vtkMultiMaterialVolumeMapper::GetNumberOfRestarts()
 {
   return this->Internal->Restarts;
@@ -665,9 +727,92 @@ const char* vtkMultiMaterialVolumeMapper::GetBackendDescription()
 // read the inputs and compare them with what the scene was made from, stop
 // a pass in flight that they outdate, update the proxies, the materials and
 // the view as far as they changed, refine, draw.
+namespace
+{
+// Whether VTK's dual depth peeling is rendering the volumes (the renderer's
+// UseDepthPeelingForVolumes with translucent geometry): its passes are in
+// the volume's render-pass key then.
+bool InDualDepthPeeling(vtkVolume* vol)
+{
+  vtkInformation* info = vol->GetPropertyKeys();
+  if (!info || !info->Has(vtkOpenGLRenderPass::RenderPasses()))
+    return false;
+  vtkInformationObjectBaseVectorKey* key = vtkOpenGLRenderPass::RenderPasses();
+  for (int i = 0; i < key->Length(info); ++i)
+    if (vtkObjectBase* pass = key->Get(info, i))
+      if (pass->IsA("vtkDualDepthPeelingPass"))
+        return true;
+  return false;
+}
+}
+
 void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
+  const auto start = std::chrono::steady_clock::now();
+  this->InvokeEvent(vtkCommand::VolumeMapperRenderStartEvent, nullptr);
+  auto* window = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!InDualDepthPeeling(vol) || !window || !window->GetRenderFramebuffer())
+    this->RenderFrame(ren, vol);
+  else if (this->TracesInThisFrame(ren))
+  {
+    // The peels' shaders split a ray into depth ranges between translucent
+    // layers; the film has no such layers. It is traced once and drawn into
+    // the window's framebuffer (its depth is the opaque geometry's, which
+    // stops the camera rays), over which the peeling blends all translucent
+    // layers when it finishes. Later calls of the frame draw nothing: the
+    // film is already there.
+    vtkOpenGLState* state = window->GetState();
+    state->PushFramebufferBindings();
+    window->GetRenderFramebuffer()->Bind();
+    GLint equation = GL_FUNC_ADD;
+    glGetIntegerv(GL_BLEND_EQUATION_RGB, &equation); // the peels blend by GL_MAX
+    state->vtkglBlendEquation(GL_FUNC_ADD);
+    {
+      vtkOpenGLState::ScopedglEnableDisable cull(state, GL_CULL_FACE);
+      state->vtkglDisable(GL_CULL_FACE);
+      this->RenderFrame(ren, vol);
+    }
+    state->vtkglBlendEquation(static_cast<unsigned int>(equation));
+    state->PopFramebufferBindings();
+  }
+  this->TimeToDraw = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  this->InvokeEvent(vtkCommand::VolumeMapperRenderEndEvent, nullptr);
+}
+
+bool vtkMultiMaterialVolumeMapper::TracesInThisFrame(vtkRenderer* ren)
+{
   Internals& in = *this->Internal;
+  Internals::PeelFrame* frame = nullptr;
+  for (const auto& f : in.PeelFrames)
+    if (f->Renderer == ren)
+      frame = f.get();
+  if (!frame)
+  {
+    in.PeelFrames.push_back(std::make_unique<Internals::PeelFrame>());
+    frame = in.PeelFrames.back().get();
+    frame->Renderer = ren;
+    vtkNew<vtkCallbackCommand> newFrame;
+    newFrame->SetClientData(frame);
+    newFrame->SetCallback(
+      [](vtkObject*, unsigned long, void* data, void*) { static_cast<Internals::PeelFrame*>(data)->Traced = false; });
+    frame->Observer = ren->AddObserver(vtkCommand::StartEvent, newFrame);
+  }
+  const bool first = !frame->Traced;
+  frame->Traced = true;
+  return first;
+}
+
+// The phases of one frame's image, drawn into the bound framebuffer.
+void vtkMultiMaterialVolumeMapper::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
+{
+  Internals& in = *this->Internal;
+  const auto start = std::chrono::steady_clock::now();
+  auto draw = [&](const mmrtm::Film& film)
+  {
+    in.LastFilmSize[0] = film.Width();
+    in.LastFilmSize[1] = film.Height();
+    this->DrawFilm(ren, vol, film);
+  };
   int viewport[4] = { 0, 0, 0, 0 }; // width, height, origin x, origin y
   if (!this->ValidateInputs(ren, vol, viewport))
     return;
@@ -685,7 +830,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       if (!in.InFlight->Done && !interactive && !changes.Any())
       {
         if (in.Shown)
-          this->DrawFilm(ren, vol, *in.Shown);
+          draw(*in.Shown);
         return;
       }
       this->FinishPass(!in.InFlight->Done); // a stopped pass leaves no film: a restart
@@ -709,13 +854,19 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
     if (interactive)
     {
-      this->RenderPreview(ren, viewport[0], viewport[1], 1.0 / window->GetDesiredUpdateRate());
-      this->DrawFilm(ren, vol, *in.Preview);
+      // The volume's share of the frame (VTK's renderer divides the
+      // window's 1 / DesiredUpdateRate among its props).
+      const double allocated = vol->GetAllocatedRenderTime();
+      const double budget = allocated > 0 && allocated < 1e6 ? allocated : 1.0 / window->GetDesiredUpdateRate();
+      const double traced = this->RenderPreview(ren, viewport[0], viewport[1]);
+      draw(*in.Preview);
+      this->AdaptPreview(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), traced, budget);
       return;
     }
     in.Preview.reset();
     if (const mmrtm::Film* film = this->Refine(restart))
-      this->DrawFilm(ren, vol, *film);
+      draw(*film);
   }
   catch (const std::exception& e)
   {
@@ -778,7 +929,16 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   // the opaque geometry (its depth), and the mapper's own settings.
   now.View.Width = viewport[0];
   now.View.Height = viewport[1];
-  now.View.Values = ViewSignature(ren, vol, now.View.Width, now.View.Height);
+  // VTK's still image: at the least distance when the distances adapt,
+  // else at ImageSampleDistance; below 1 is 1 (samples cover a pixel).
+  const double distance = std::max(1.0,
+    static_cast<double>(
+      this->AutoAdjustSampleDistances ? this->MinimumImageSampleDistance : this->ImageSampleDistance));
+  now.View.FilmWidth = FilmSize(viewport[0], distance);
+  now.View.FilmHeight = FilmSize(viewport[1], distance);
+  now.View.Values = ViewSignature(ren, vol, now.View.FilmWidth, now.View.FilmHeight);
+  now.View.Values.insert(
+    now.View.Values.end(), { static_cast<double>(now.View.Width), static_cast<double>(now.View.Height) });
   now.View.Clip = this->ClipPlanes(vol);
   for (const mmrtm::ClipPlane& p : now.View.Clip)
     now.View.Values.insert(now.View.Values.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
@@ -903,11 +1063,13 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
   for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
     in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
   mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
-  const int width = now.View.Width, height = now.View.Height;
+  const int width = now.View.FilmWidth, height = now.View.FilmHeight;
   // Camera rays stop at opaque geometry: it hides the volume behind it,
   // and the volume in front of it hides it.
-  in.Scene.cameraRayMaxDistance =
-    now.View.Depth.empty() ? std::vector<float>() : CameraRayMaxDistance(ren, now.View.Depth, width, height);
+  in.Scene.cameraRayMaxDistance = now.View.Depth.empty()
+    ? std::vector<float>()
+    : CameraRayMaxDistance(
+        ren, DepthAtFilmPixels(now.View.Depth, now.View.Width, now.View.Height, width, height), width, height);
   if (!in.LightsFromScene)
     mmrtm::SetLightsFromVtk(ren, now.Materials.Property, in.Scene);
   if (in.Environment)
@@ -955,7 +1117,7 @@ void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
   }
   else
   {
-    in.Film = std::make_unique<mmrtm::Film>(view.Width, view.Height);
+    in.Film = std::make_unique<mmrtm::Film>(view.FilmWidth, view.FilmHeight);
     ++in.Restarts;
   }
   if (keepPrevious)
@@ -1051,6 +1213,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   const int samples = this->IsConverged() ? 0
     : this->MaximumSamples > 0            ? std::min(perRender, this->MaximumSamples - accumulated)
                                           : perRender;
+  if (samples > 0)
+    ++in.TracedPasses;
   if (samples > 0 && this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown)
   {
     // The next pass on a thread of its own, under in.Built; this render
@@ -1312,42 +1476,47 @@ std::vector<mmrtm::ClipPlane> vtkMultiMaterialVolumeMapper::ClipPlanes(vtkVolume
   return planes;
 }
 
-void vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds)
+double vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, int height)
 {
   Internals& in = *this->Internal;
-  const int f = in.PreviewFactor;
-  const int w = std::max(1, (width + f - 1) / f), h = std::max(1, (height + f - 1) / f);
+  const double distance = this->AutoAdjustSampleDistances
+    ? in.PreviewDistance
+    : std::max(1.0, static_cast<double>(this->ImageSampleDistance));
+  const int w = FilmSize(width, distance), h = FilmSize(height, distance);
   mmrtm::RenderSettings& rs = in.Scene.render;
   rs.width = w;
   rs.height = h;
-  // The depth buffer at the preview's pixel centres.
   const std::vector<float>& fullDepth = in.Built.View.Depth;
   if (!fullDepth.empty())
-  {
-    std::vector<float> depth(static_cast<size_t>(w) * h);
-    for (int row = 0; row < h; ++row)
-      for (int x = 0; x < w; ++x)
-      {
-        const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / w));
-        const int fy = std::min(height - 1, static_cast<int>((row + 0.5) * height / h));
-        depth[static_cast<size_t>(row) * w + x] = fullDepth[static_cast<size_t>(fy) * width + fx];
-      }
-    in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, depth, w, h);
-  }
+    in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, DepthAtFilmPixels(fullDepth, width, height, w, h), w, h);
   const mmrtm::SceneView view = in.Scene.Build();
   in.CountGridWork();
   in.Preview = std::make_unique<mmrtm::Film>(w, h);
   const auto start = std::chrono::steady_clock::now();
   in.Renderer->Render(in.Scene, view, *in.Preview, 1, nullptr, nullptr);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // Aim at the frame budget: coarser when too slow, finer when fast.
-  if (seconds > 1.3 * budgetSeconds && in.PreviewFactor < 16)
-    ++in.PreviewFactor;
-  else if (seconds < 0.4 * budgetSeconds && in.PreviewFactor > 1)
-    --in.PreviewFactor;
+  ++in.TracedPasses;
   // The still render after the interaction starts again at full resolution.
   in.Film.reset();
   ++in.InteractiveRenders;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void vtkMultiMaterialVolumeMapper::AdaptPreview(double seconds, double tracedSeconds, double budgetSeconds)
+{
+  // The tracing time scales with the film's pixels, 1 / distance^2; the
+  // rest of the frame (reading the inputs and the depth, drawing) is taken
+  // as fixed. The distance that would have fit the budget, averaged
+  // (geometrically) with the one used, so that one noisy frame does not
+  // swing the next.
+  Internals& in = *this->Internal;
+  if (!this->AutoAdjustSampleDistances)
+    return;
+  const double least = std::max(1.0, static_cast<double>(this->MinimumImageSampleDistance));
+  const double most = std::max(least, static_cast<double>(this->MaximumImageSampleDistance));
+  const double d = in.PreviewDistance;
+  const double forTracing = std::max(0.1 * budgetSeconds, budgetSeconds - (seconds - tracedSeconds));
+  const double fits = d * std::sqrt(std::max(tracedSeconds, 1e-6) / forTracing);
+  in.PreviewDistance = std::min(most, std::max(least, std::sqrt(d * fits)));
 }
 
 void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
@@ -1423,5 +1592,10 @@ void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Accelerator: " << this->Accelerator << "\n";
   os << indent << "Sampler: " << (this->Sampler == INDEPENDENT ? "independent" : "sobol") << "\n";
   os << indent << "MaximumBounces: " << this->MaximumBounces << "\n";
+  os << indent << "ImageSampleDistance: " << this->ImageSampleDistance << "\n";
+  os << indent << "MinimumImageSampleDistance: " << this->MinimumImageSampleDistance << "\n";
+  os << indent << "MaximumImageSampleDistance: " << this->MaximumImageSampleDistance << "\n";
+  os << indent << "AutoAdjustSampleDistances: " << this->AutoAdjustSampleDistances << "\n";
+  os << indent << "SampleDistance: " << this->SampleDistance << "\n";
   os << indent << "AccumulatedSamples: " << this->GetAccumulatedSamples() << "\n";
 }

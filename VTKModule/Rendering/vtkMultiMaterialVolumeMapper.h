@@ -26,7 +26,11 @@
  * non-uniform scales render correctly. The image is composited premultiplied
  * in front of everything else in the viewport: camera rays stop at the
  * opaque geometry VTK drew first (its depth buffer), so where that geometry
- * is in front the image is transparent.
+ * is in front the image is transparent. With the renderer's depth peeling
+ * for volumes (SetUseDepthPeelingForVolumes) the image is traced once per
+ * frame and drawn under all translucent geometry, which VTK's peeling then
+ * blends over it (it cannot be peeled: the tracer's film has no depth
+ * layers).
  *
  * Clipping planes (world space) and cropping (data space, every region
  * set) limit what is seen. Not supported yet (a warning is given once per
@@ -313,6 +317,54 @@ public:
   vtkBooleanMacro(InteractiveAdjustResolution, vtkTypeBool);
   ///@}
 
+  ///@{
+  /**
+   * VTK's image sample distances (vtkGPUVolumeRayCastMapper's names,
+   * meanings and defaults; vtkVolumeMapper does not declare them): the
+   * film's pixel is ImageSampleDistance viewport pixels wide (1, the
+   * default: one film pixel per viewport pixel; 2: a film of half the
+   * width and height, stretched over the viewport). Values below 1 render
+   * as 1: the tracer's samples per pixel already cover the pixel.
+   *
+   * AutoAdjustSampleDistances on (the default): a still render is at
+   * MinimumImageSampleDistance (1) and ImageSampleDistance is not used, as
+   * in VTK's GPU mapper; an interactive preview (see
+   * InteractiveAdjustResolution) adapts its distance between
+   * MinimumImageSampleDistance (1) and MaximumImageSampleDistance (10) so
+   * that a frame takes the volume's AllocatedRenderTime (which VTK's
+   * renderer sets from the window's DesiredUpdateRate, divided among the
+   * props). Off: still renders and previews are at ImageSampleDistance.
+   */
+  vtkSetClampMacro(ImageSampleDistance, float, 0.1f, 100.0f);
+  vtkGetMacro(ImageSampleDistance, float);
+  vtkSetClampMacro(MinimumImageSampleDistance, float, 0.1f, 100.0f);
+  vtkGetMacro(MinimumImageSampleDistance, float);
+  vtkSetClampMacro(MaximumImageSampleDistance, float, 0.1f, 100.0f);
+  vtkGetMacro(MaximumImageSampleDistance, float);
+  vtkSetClampMacro(AutoAdjustSampleDistances, vtkTypeBool, 0, 1);
+  vtkGetMacro(AutoAdjustSampleDistances, vtkTypeBool);
+  vtkBooleanMacro(AutoAdjustSampleDistances, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * VTK's distance between samples along a ray (world units, default 1,
+   * as in vtkGPUVolumeRayCastMapper). It does not affect the path tracer:
+   * delta and ratio tracking sample free paths exactly, without a step. It
+   * is kept so that code written for VTK's mappers (3D Slicer's quality
+   * settings) can set it; a change restarts the accumulation.
+   */
+  vtkSetMacro(SampleDistance, float);
+  vtkGetMacro(SampleDistance, float);
+  ///@}
+
+  /**
+   * The size (width, height) of the last film drawn: the accumulation's,
+   * or an interactive preview's. The viewport's size divided by the image
+   * sample distance in use (see ImageSampleDistance), rounded up.
+   */
+  void GetLastFilmSize(int size[2]);
+
   /**
    * Discards the accumulated samples; the next Render() starts again.
    */
@@ -355,6 +407,16 @@ public:
   int GetNumberOfRestarts();
   int GetNumberOfInteractiveRenders();
   ///@}
+
+  /**
+   * How often the tracer ran: a still render that added samples, an
+   * interactive preview, or a pass started on the refinement thread. A
+   * frame traces at most once, however often VTK calls Render() in it (with
+   * depth peeling for volumes VTK calls it once per peel), and a render that
+   * only redraws (converged, or a further call in the same frame) does not
+   * trace.
+   */
+  int GetNumberOfTracedPasses();
 
   /**
    * How often the majorant grid's per-voxel summaries were built (the
@@ -412,6 +474,11 @@ protected:
   double ShadowExtinctionScale = 0.8;
   int MaskType = LABELMAP;
   vtkTypeBool InteractiveAdjustResolution = 1;
+  float ImageSampleDistance = 1.0f;
+  float MinimumImageSampleDistance = 1.0f;
+  float MaximumImageSampleDistance = 10.0f;
+  vtkTypeBool AutoAdjustSampleDistances = 1;
+  float SampleDistance = 1.0f;
   double EnvironmentIntensity = 1.0;
 
   /**
@@ -431,6 +498,8 @@ private:
   bool ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4]);
   InputState ReadInputs(vtkRenderer* ren, vtkVolume* vol, const int viewport[4]);
   void ReadTracedImage(InputState& now); // the input as the tracer's image (part of ReadInputs)
+  void RenderFrame(vtkRenderer* ren, vtkVolume* vol);
+  bool TracesInThisFrame(vtkRenderer* ren);
   Changes ChangesSince(const InputState& built, const InputState& now);
   void UpdateProxies(const InputState& now);
   void UpdateDescription(const InputState& now);
@@ -440,7 +509,8 @@ private:
   void UpdateRenderer();
   mmrtm::ProjectionSettings Projection(vtkVolumeProperty* property);
   const mmrtm::Film* Refine(bool restart);
-  void RenderPreview(vtkRenderer* ren, int width, int height, double budgetSeconds);
+  double RenderPreview(vtkRenderer* ren, int width, int height); // the tracing's seconds
+  void AdaptPreview(double seconds, double tracedSeconds, double budgetSeconds);
   std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();
