@@ -23,7 +23,11 @@
 #include <vtkOpenGLRenderWindow.h>
 #include <vtkOpenGLState.h>
 #include <vtkWeakPointer.h>
+#if __has_include(<vtk_glad.h>)
+#include <vtk_glad.h> // VTK 9.4 and later
+#else
 #include <vtk_glew.h>
+#endif
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
@@ -1131,8 +1135,8 @@ void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
 mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProperty* property)
 {
   // VTK's projection blend modes (mmrtm/projection.h), sampled as VTK's GPU
-  // mapper samples them with AutoAdjustSampleDistances on (its default):
-  // at the smallest spacing of the volume in world space.
+  // mapper samples them: with AutoAdjustSampleDistances on (its default) at
+  // the smallest spacing of the volume in world space, else SampleDistance.
   Internals& in = *this->Internal;
   mmrtm::ProjectionSettings p;
   switch (this->BlendMode)
@@ -1161,6 +1165,8 @@ mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProp
       step, std::sqrt(m.m[0][axis] * m.m[0][axis] + m.m[1][axis] * m.m[1][axis] + m.m[2][axis] * m.m[2][axis]));
   }
   p.step = step > 0.f ? step : 1.f;
+  if (!this->AutoAdjustSampleDistances && this->SampleDistance > 0.f)
+    p.step = this->SampleDistance;
   const double unit = property->GetScalarOpacityUnitDistance(0);
   p.opacityUnitDistance = unit > 0.0 ? static_cast<float>(unit) : 1.f;
   const std::array<float, 2> range =

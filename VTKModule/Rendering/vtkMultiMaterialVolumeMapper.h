@@ -350,9 +350,11 @@ public:
   /**
    * VTK's distance between samples along a ray (world units, default 1,
    * as in vtkGPUVolumeRayCastMapper). It does not affect the path tracer:
-   * delta and ratio tracking sample free paths exactly, without a step. It
-   * is kept so that code written for VTK's mappers (3D Slicer's quality
-   * settings) can set it; a change restarts the accumulation.
+   * delta and ratio tracking sample free paths exactly, without a step.
+   * The projection blend modes (maximum, minimum, average intensity,
+   * additive) step by it when AutoAdjustSampleDistances is off, else by the
+   * volume's smallest voxel spacing, as VTK's GPU mapper does. A change
+   * restarts the accumulation.
    */
   vtkSetMacro(SampleDistance, float);
   vtkGetMacro(SampleDistance, float);
