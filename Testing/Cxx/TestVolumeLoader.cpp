@@ -459,10 +459,19 @@ TEST(VolumeLoader, MetaImageWithTooFewVoxelsIsRefused) {
   ExpectInputError(CopyFrogWithHeaderEdit("frog_dims", "DimSize = 500 470 136", "DimSize = 500 470 140"), "expected");
 }
 
-TEST(VolumeLoader, NanVoxelIsRejected) {
+// A NaN voxel (a hole in a simulation) is read as the volume's least value,
+// and counted for the caller's warning; an infinite one stays an error.
+// Catches a NaN passed on to the tracer (no image) or refused.
+TEST(VolumeLoader, NanVoxelIsTheLeastValueAndInfinityIsRejected) {
   const std::string path = Scratch("nan.nrrd");
-  std::vector<float> values(3 * 2 * 2, 1.f);
+  std::vector<float> values(3 * 2 * 2, 2.f);
+  values[2] = -1.f;
   values[7] = std::numeric_limits<float>::quiet_NaN();
+  WriteFloatNrrd(path, "dimension: 3\nsizes: 3 2 2\nspacings: 1 1 1\n", values);
+  const HostVolume v = LoadVolume(path, "scalars");
+  EXPECT_EQ(v.nanVoxelsReplaced, 1);
+  EXPECT_EQ(v.Value(7), -1.f);  // the least value
+  values[7] = std::numeric_limits<float>::infinity();
   WriteFloatNrrd(path, "dimension: 3\nsizes: 3 2 2\nspacings: 1 1 1\n", values);
   ExpectInputError(path, "non-finite");
 }

@@ -533,10 +533,12 @@ std::vector<Case> Cases()
     { "environment-texture", Work::Restart }, { "environment-intensity", Work::Restart },
     { "environment-texels", Work::Restart }, { "clipping-plane", Work::Restart },
     { "clipping-plane-moved", Work::Restart }, { "cropping", Work::Restart } };
-  // Edits of what is not extinction (colours, shading, surfaces) keep the majorants.
+  // Edits of what is not extinction (colours, shading, surfaces) keep the
+  // majorants; a component weight between 0 and 1 scales the component's
+  // colour, as VTK's GPU mapper does, not its extinction.
   for (const char* name : { "color-rgb-point", "color-rgb-to-gray", "color-gray-point", "shade-on", "shade-off",
          "ambient", "diffuse", "specular", "specular-power", "interpolation-nearest", "transfer-function-2d",
-         "component-color-point", "label-color-point", "label-color-replaced", "label-material",
+         "component-weight", "component-color-point", "label-color-point", "label-color-replaced", "label-material",
          "label-material-edited", "label-material-removed", "label-look-colour" })
     work[name] = Work::Translate;
   for (Case& x : c)

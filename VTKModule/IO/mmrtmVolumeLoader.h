@@ -41,8 +41,10 @@ namespace mmrtm
 //
 // Throws InputError, whose message names the file and the problem, for a
 // missing path, an unknown extension, an unreadable, corrupt or truncated
-// file, an empty volume, more than one component per voxel, non-finite
-// voxels and folders without readable DICOM files.
+// file, an empty volume, more than one component per voxel, infinite
+// voxels and folders without readable DICOM files. NaN voxels are read as
+// the volume's least value (HostVolume::ReplaceNanVoxels; counted in
+// nanVoxelsReplaced for the caller's warning).
 HostVolume LoadVolume(
   const std::string& path, const std::string& name = "scalars", Interpolation interpolation = Interpolation::Trilinear);
 
