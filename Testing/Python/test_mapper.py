@@ -239,6 +239,24 @@ class MapperTest(unittest.TestCase):
         s.render()
         self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
         self.assertFalse(s.mapper.IsConverged())
+        # Over a multi-material description (its own materials; the
+        # average normalises by the input's value range, kept from the
+        # build: lost, the image is black).
+        materials = vtkMultiMaterialProperty()
+        self.assertTrue(materials.SetPreset("ct-bone"))
+        self.assertTrue(materials.MergeSceneJSON(
+            '{"materials": {"bone": {"tfs": {"density": [{"type": "cctf", "proxy": "scalars",'
+            ' "points": [[1100, 0], [1500, 0.5], [2500, 1]]}]}}}}'))
+        s.mapper.SetMultiMaterialProperty(materials)
+        s.mapper.SetBlendModeToAverageIntensity()
+        s.mapper.SetAverageIPScalarRange(1100, 4000)  # the bone's samples only
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 1)
+        average = s.pixels()
+        self.assertGreater(coverage(average), 0.05)
+        # 88 here; a lost range makes the average black and leaves the
+        # background's 38 as the brightest channel.
+        self.assertGreater(max(average), 60, "the average is not black")
 
     def test_transfer_function_change_refits_and_restarts(self):
         s = Scene()

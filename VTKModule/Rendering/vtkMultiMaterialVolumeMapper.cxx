@@ -16,27 +16,21 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCommand.h>
-#include <vtkInformation.h>
-#include <vtkInformationObjectBaseVectorKey.h>
-#include <vtkOpenGLFramebufferObject.h>
-#include <vtkOpenGLRenderPass.h>
-#include <vtkOpenGLRenderWindow.h>
-#include <vtkOpenGLState.h>
-#include <vtkWeakPointer.h>
-#if __has_include(<vtk_glad.h>)
-#include <vtk_glad.h> // VTK 9.4 and later
-#else
-#include <vtk_glew.h>
-#endif
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkImageData.h>
+#include <vtkInformation.h>
+#include <vtkInformationObjectBaseVectorKey.h>
 #include <vtkLight.h>
 #include <vtkLightCollection.h>
 #include <vtkMatrix4x4.h>
 #include <vtkObjectFactory.h>
+#include <vtkOpenGLFramebufferObject.h>
+#include <vtkOpenGLRenderPass.h>
+#include <vtkOpenGLRenderWindow.h>
+#include <vtkOpenGLState.h>
 #include <vtkPiecewiseFunction.h>
 #include <vtkPlane.h>
 #include <vtkPlaneCollection.h>
@@ -50,6 +44,12 @@
 #include <vtkSmartPointer.h>
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
+#include <vtkWeakPointer.h>
+#if __has_include(<vtk_glad.h>)
+#include <vtk_glad.h> // VTK 9.4 and later: the GL enums
+#else
+#include <vtk_glew.h>
+#endif
 
 #include "derived_proxies.h"
 #include "film.h"
@@ -1169,10 +1169,8 @@ mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProp
     p.step = this->SampleDistance;
   const double unit = property->GetScalarOpacityUnitDistance(0);
   p.opacityUnitDistance = unit > 0.0 ? static_cast<float>(unit) : 1.f;
-  const std::array<float, 2> range =
-    in.Layout.scalarRange[1] > in.Layout.scalarRange[0] ? in.Layout.scalarRange : volume.ValueRange();
-  p.valueRange[0] = range[0];
-  p.valueRange[1] = range[1];
+  p.valueRange[0] = in.Layout.scalarRange[0]; // the input's (BuildProxies), not scanned per restart
+  p.valueRange[1] = in.Layout.scalarRange[1];
   p.averageRange[0] = static_cast<float>(std::max<double>(this->AverageIPScalarRange[0], -FLT_MAX));
   p.averageRange[1] = static_cast<float>(std::min<double>(this->AverageIPScalarRange[1], FLT_MAX));
   return p;
@@ -1399,7 +1397,9 @@ void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
       inputs.volumes["labels"] = std::move(in.Scene.proxies[i]);
   in.LightsFromScene = doc.contains("lights");
   in.Scene = mmrtm::SceneFromJson(doc, std::move(inputs));
+  const std::array<float, 2> range = in.Layout.scalarRange; // the input's, for the projections
   in.Layout = mmrtm::ProxyLayout();
+  in.Layout.scalarRange = range;
   ++in.Refits;
 }
 
@@ -1414,7 +1414,9 @@ void vtkMultiMaterialVolumeMapper::ReparseMultiMaterialScene()
   in.HasScene = false; // until the parse succeeds; after a failure the input is read again
   mmrtm::Scene previous = std::move(in.Scene);
   in.Scene = mmrtm::Scene();
+  const std::array<float, 2> range = in.Layout.scalarRange; // the input's, for the projections
   in.Layout = mmrtm::ProxyLayout();
+  in.Layout.scalarRange = range;
   const int labels = previous.ProxyIndex("labels");
   for (const int i : { 0, labels })
   {

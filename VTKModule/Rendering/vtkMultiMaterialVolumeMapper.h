@@ -33,8 +33,10 @@
  * layers).
  *
  * Clipping planes (world space) and cropping (data space, every region
- * set) limit what is seen. Not supported yet (a warning is given once per
- * cause): blend modes other than composite, more than four independent
+ * set) limit what is seen. The maximum, minimum and average intensity and
+ * additive blend modes are projections, as VTK's GPU mapper computes them.
+ * Not supported yet (a warning is given once per cause): isosurface
+ * blending (rendered as composite), more than four independent
  * components, gradient opacity of independent components beyond the four
  * proxies.
  *
