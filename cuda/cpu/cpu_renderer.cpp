@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mmrtm/integrator.h"
+#include "cpu_projection.h"
 
 namespace mmrtm {
 
@@ -56,6 +57,7 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   int tilesDone = 0;
   std::vector<TraceCounters> perThread(threads_);
 
+  const bool projecting = s.settings.projection.mode != IntensityProjection::None;  // mmrtm/projection.h
   auto worker = [&](int thread) {
     TraceCounters& ctr = perThread[thread];
     for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
@@ -65,6 +67,13 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
           const uint32_t first = film.PixelSamples(x, y), last = end((size_t)y * width + x, first);
+          if (projecting) {
+            for (uint32_t index = first; index < last; ++index) {
+              const PixelSample ps = ProjectPixelOnCpu(s, x, y, ctr);
+              view.AddSample(x, y, ps.L, ps.alpha, index + 1);
+            }
+            continue;
+          }
           const uint64_t workBefore = ctr.Work();
           for (uint32_t index = first; index < last; ++index) {
             PixelSample ps = RenderPixelSample(s, x, y, index, ctr);

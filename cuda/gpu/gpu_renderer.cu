@@ -12,6 +12,7 @@
 #include "device_buffer.h"
 #include "mmrtm/integrator.h"
 #include "mmrtm/majorant_refit.h"
+#include "mmrtm/projection.h"
 #include "scene_relocation.h"
 
 namespace mmrtm {
@@ -29,7 +30,9 @@ __global__ void RenderSampleKernel(SceneView scene, FilmView film, uint32_t inde
   const int64_t pixel = x + (int64_t)film.width * y;
   if (first && (index < first[pixel] || index >= end[pixel])) return;
   TraceCounters ctr;
-  const PixelSample ps = RenderPixelSample(scene, x, y, index, ctr);
+  const PixelSample ps = scene.settings.projection.mode != IntensityProjection::None
+                             ? ProjectPixel(scene, x, y, ctr)
+                             : RenderPixelSample(scene, x, y, index, ctr);
   film.AddSample(x, y, ps.L, ps.alpha, index + 1);
   film.AddWork(x, y, (float)ctr.Work());
   auto add = [](uint64_t* total, uint64_t v) {

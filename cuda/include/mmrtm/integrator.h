@@ -19,7 +19,6 @@
 #include "mmrtm/bsdf.h"
 #include "mmrtm/phase.h"
 #include "mmrtm/planted_defect.h"
-#include "mmrtm/projection.h"
 #include "mmrtm/sobol.h"
 #include "mmrtm/tracking.h"
 
@@ -241,11 +240,9 @@ MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, in
     l0 = rng.Uniform();
     l1 = rng.Uniform();
   }
+  Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
   ++ctr.paths;
   const float tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
-  if (s.settings.projection.mode != IntensityProjection::None)  // through the pixel's centre: one sample is the image
-    return ProjectRay(s, s.camera.GenerateRay((float)x + 0.5f, (float)y + 0.5f, 0.5f, 0.5f), tMax, ctr);
-  Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
   return Li(s, ray, rng, ctr, tMax, sobol ? &pairs : nullptr);
 }
 
