@@ -12,8 +12,8 @@
 // equal B's to the bit: stale translation state in A (a function not read
 // again, a proxy not rebuilt, a material left over) cannot hide behind the
 // noise. Each edit must also change A's image (the edit is not a no-op),
-// except the few the mapper documents as not used (Diffuse, the
-// interpolation type, the exposure, which applies after the film). And A
+// except the few the mapper documents as not used (the interpolation
+// type) or as applied after the film (the exposure, the tone mapping). And A
 // must do the work its kind of edit needs and no more (Work: counted by the
 // mapper's scene builds, translations, restarts, and the majorant grid's
 // builds and refits): the exposure and an unchanged render none, a camera
@@ -38,6 +38,7 @@
 
 #include <vtkCamera.h>
 #include <vtkColorTransferFunction.h>
+#include <vtkContourValues.h>
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkImageShrink3D.h>
@@ -348,7 +349,7 @@ std::vector<Case> Cases()
   c.push_back({ "shade-on", Input::Head, HeadFunctions, [](Objects& o) { o.property->ShadeOn(); } });
   c.push_back({ "shade-off", Input::Head, Shaded, [](Objects& o) { o.property->ShadeOff(); } });
   c.push_back({ "ambient", Input::Head, Shaded, [](Objects& o) { o.property->SetAmbient(0.8); } });
-  c.push_back({ "diffuse", Input::Head, Shaded, [](Objects& o) { o.property->SetDiffuse(0.2); }, false });
+  c.push_back({ "diffuse", Input::Head, Shaded, [](Objects& o) { o.property->SetDiffuse(0.2); } });
   c.push_back({ "specular", Input::Head, Shaded, [](Objects& o) { o.property->SetSpecular(0.0); } });
   c.push_back({ "specular-power", Input::Head, Shaded, [](Objects& o) { o.property->SetSpecularPower(60); } });
   c.push_back({ "interpolation-nearest", Input::Head,
@@ -433,7 +434,13 @@ std::vector<Case> Cases()
       yellow->AddRGBPoint(0, 0.9, 0.9, 0.1);
       o.property->SetLabelColor(2, yellow);
     } });
-  c.push_back({ "label-material", Input::HeadLabels, labelled,
+  // Shaded: a glowing (unshaded) label has no surface to give parameters to.
+  c.push_back({ "label-material", Input::HeadLabels,
+    [&](Objects& o)
+    {
+      labelled(o);
+      o.property->ShadeOn();
+    },
     [](Objects& o)
     { o.mapper->SetLabelMaterialParameters(1, R"({"roughness": 0.2, "metallic": 1, "surface_probability": 1})"); } });
   c.push_back({ "label-material-edited", Input::HeadLabels,
@@ -522,6 +529,27 @@ std::vector<Case> Cases()
   c.push_back(
     { "exposure", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetExposure(2.0); }, false, Work::Display });
   c.push_back({ "nothing", Input::Head, HeadFunctions, [](Objects&) {}, false, Work::Display });
+  c.push_back({ "tone-mapping", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetToneMappingToFilmic(); },
+    false, Work::Display });
+  c.push_back({ "unshaded-scattering", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->UnshadedScatteringOn(); },
+    true, Work::Translate });
+  // Isosurfaces read the gradient magnitude: a proxy more (a rebuild);
+  // another iso-value moves the extinction (a refit).
+  c.push_back({ "isosurface-blend", Input::Head,
+    [](Objects& o)
+    {
+      Shaded(o);
+      o.property->GetIsoSurfaceValues()->SetValue(0, 1200);
+    },
+    [](Objects& o) { o.mapper->SetBlendModeToIsoSurface(); }, true, Work::Rebuild });
+  c.push_back({ "iso-value", Input::Head,
+    [](Objects& o)
+    {
+      Shaded(o);
+      o.property->GetIsoSurfaceValues()->SetValue(0, 1200);
+      o.mapper->SetBlendModeToIsoSurface();
+    },
+    [](Objects& o) { o.property->GetIsoSurfaceValues()->SetValue(0, 1600); } });
 
   // The work of the edits that do not only translate the property again.
   std::map<std::string, Work> work = { { "gradient-opacity-enabled", Work::Rebuild },

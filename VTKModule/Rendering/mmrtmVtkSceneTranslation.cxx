@@ -65,15 +65,42 @@ double UnitDistance(vtkVolumeProperty* property, int component)
   return std::isnan(d) ? 1.0 : std::max(d, 1e-6); // NaN: VTK's default; 0 or less: opaque (Classifier clamps)
 }
 
+// The material's colour (its albedo and the functions bound to it) as its
+// emission, and no albedo: it glows and scatters nothing.
+void Glow(MaterialDesc& m)
+{
+  for (MaterialDesc::Binding& b : m.bindings)
+    if (b.quantity == Quantity::Albedo)
+      b.quantity = Quantity::Emission;
+  for (int c = 0; c < 3; ++c)
+  {
+    m.base[QuantityOffset(Quantity::Emission) + c] = m.base[QuantityOffset(Quantity::Albedo) + c];
+    m.base[QuantityOffset(Quantity::Albedo) + c] = 0.f;
+  }
+}
+
 // Shade, Specular and SpecularPower on a material (the rule in the header).
-void ApplyShading(vtkVolumeProperty* property, int component, MaterialDesc& m)
+void ApplyShading(vtkVolumeProperty* property, int component, const TranslationOptions& options, MaterialDesc& m)
 {
   const bool shade = property->GetShade(component) != 0;
-  m.base[QuantityOffset(Quantity::SurfaceProbability)] = shade ? kShadedSurfaceProbability : 0.f;
+  m.base[QuantityOffset(Quantity::SurfaceProbability)] =
+    shade ? (options.localLighting ? 1.f : kShadedSurfaceProbability) : 0.f;
   const double specular = property->GetSpecular(component),
                power = std::max(property->GetSpecularPower(component), 0.0);
   m.base[QuantityOffset(Quantity::Roughness)] =
     specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
+  if (!shade && !options.unshadedScatters)
+    Glow(m);
+}
+
+// The colour of a material, scattered or glowing, times `factor`.
+void ScaleColour(MaterialDesc& m, float factor)
+{
+  for (int c = 0; c < 3; ++c)
+  {
+    m.base[QuantityOffset(Quantity::Albedo) + c] *= factor;
+    m.base[QuantityOffset(Quantity::Emission) + c] *= factor;
+  }
 }
 
 bool IsConstantOne(vtkPiecewiseFunction* f)
@@ -208,10 +235,43 @@ MaterialFunctions ComponentFunctions(vtkVolumeProperty* property, int c, FiniteF
   return f;
 }
 
+// The extinction of isosurfaces (the rule in the header): a piecewise-
+// constant factor over the scalars, tau(v) / (2 delta) in the band
+// (v - delta, v + delta) of each iso-value v and 0 elsewhere, times the
+// gradient magnitude, so that a ray crossing a band along the gradient
+// meets the optical depth tau(v) (its path through the band is
+// 2 delta / |grad|); at an angle it meets more, as a thin film does.
+void AddIsoSurfaces(const std::string& name, vtkPiecewiseFunction* opacity, double unitDistance,
+  const TranslationOptions& options, const ProxyLayout& proxies, Scene& scene, MaterialDesc& m)
+{
+  const float delta = std::max(kIsoBandFraction * (proxies.scalarRange[1] - proxies.scalarRange[0]), 1e-6f);
+  TransferFunctionDesc band;
+  band.where = name + " isosurfaces";
+  band.type = TFType::CPCTF;
+  band.proxy = 0;
+  band.channels = 1;
+  for (double v : options.isoValues)
+  {
+    if (!std::isfinite(v))
+      continue;
+    const float depth = Extinction(opacity->GetValue(v), unitDistance) * options.isoSampleDistance;
+    band.keys.insert(band.keys.end(), { (float)v - delta, (float)v + delta });
+    band.values.push_back(depth / (2.f * delta));
+  }
+  if (band.values.empty()) // no iso-value: nothing shows, as in VTK
+    band.keys = { 0.f, 0.f }, band.values = { 0.f };
+  scene.tfs.push_back(std::move(band)); // 0 outside the bands
+  m.bindings.push_back({ (int)scene.tfs.size() - 1, Quantity::Density });
+  const float top = std::max(proxies.gradientRange[1], 1.f);
+  m.bindings.push_back(
+    { AddCurve(scene, name + " isosurface gradient", proxies.gradient, { 0.f, top }, { 0.f, top }, 1),
+      Quantity::Density });
+}
+
 // `valueProxy` holds the values the functions read (the scalars, or an
 // independent component), over `valueRange`.
 MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, vtkVolumeProperty* property,
-  int component, const ProxyLayout& proxies, Scene& scene, int valueProxy = 0,
+  int component, const ProxyLayout& proxies, const TranslationOptions& options, Scene& scene, int valueProxy = 0,
   const std::array<float, 2>* valueRange = nullptr)
 {
   MaterialDesc m;
@@ -232,7 +292,12 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
   for (int i = 0; i < no; ++i)
     density[i] = Extinction(alpha[i], UnitDistance(property, component));
   m.base[QuantityOffset(Quantity::Density)] = 1.f;
-  m.bindings.push_back({ AddCurve(scene, name + " scalar opacity", opacityProxy, xo, density, 1), Quantity::Density });
+  const bool iso = options.isosurface && proxies.gradient >= 0 && proxies.independent <= 1 && proxies.opacity < 0;
+  if (iso)
+    AddIsoSurfaces(name, f.opacity, UnitDistance(property, component), options, proxies, scene, m);
+  else
+    m.bindings.push_back(
+      { AddCurve(scene, name + " scalar opacity", opacityProxy, xo, density, 1), Quantity::Density });
 
   // Gradient opacity multiplies the extinction.
   if (f.gradientOpacity && proxies.gradient >= 0)
@@ -282,7 +347,9 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     }
     m.bindings.push_back({ AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo });
   }
-  ApplyShading(property, component, m);
+  ApplyShading(property, component, options, m);
+  if (iso && property->GetShade(component))
+    m.base[QuantityOffset(Quantity::SurfaceProbability)] = 1.f; // a surface, not a medium
   return m;
 }
 
@@ -322,8 +389,8 @@ namespace
 // columns), where VTK interpolates between columns.
 constexpr int kMax2DBands = 64;
 
-void Add2DMaterials(
-  vtkImageData* table, vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
+void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
+  const TranslationOptions& options, Scene& scene)
 {
   int dims[3];
   table->GetDimensions(dims);
@@ -367,7 +434,7 @@ void Add2DMaterials(
     m.base[QuantityOffset(Quantity::Density)] = 1.f;
     m.bindings.push_back({ AddCurve(scene, m.name + " opacity", proxies.gradient, g, density, 1), Quantity::Density });
     m.bindings.push_back({ AddCurve(scene, m.name + " color", proxies.gradient, g, albedo, 3), Quantity::Albedo });
-    ApplyShading(property, component, m);
+    ApplyShading(property, component, options, m);
     selector.keys.push_back((float)lo);
     selector.keys.push_back((float)hi);
     selector.materials.push_back((int)scene.materials.size());
@@ -387,7 +454,8 @@ namespace
 const char* const kLabelGate = "label map: labels with functions";
 
 // Returns how many function node values were not finite.
-int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
+int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
+  const TranslationOptions& options, Scene& scene)
 {
   FiniteFunctions finite;
   scene.tfs.clear();
@@ -403,22 +471,21 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
       ProxyLayout own = proxies; // this component's gradient proxy, if there was room for one
       own.gradient = proxies.componentGradient[c];
       own.gradientRange = proxies.componentGradientRanges[c];
-      MaterialDesc m =
-        MakeMaterial("component " + std::to_string(c), f, property, c, own, scene, c, &proxies.componentRanges[c]);
+      MaterialDesc m = MakeMaterial(
+        "component " + std::to_string(c), f, property, c, own, options, scene, c, &proxies.componentRanges[c]);
       // VTK's GPU mapper composites a sample of independent components as
       // premultiplied colour sum(w_i a_i c_i) over opacity
       // sum(a_i^2) / sum(w_i a_i) (vtkVolumeShaderComposer.h): a component
       // alone has opacity a / w and colour w^2 c, so where it is opaque the
       // weight scales its colour by w^2 and its coverage hardly changes.
-      // Ours keeps the component's extinction and scales its albedo by
+      // Ours keeps the component's extinction and scales its colour by
       // w^2; weight 0 removes it, as VTK drops it where it is alone (VTK's
       // opacity a / w grows without bound below that). vtkVolumeProperty
       // clamps weights to [0, 1]; NaN stays NaN, counted by
       // ReplaceNonFinite (the component then holds nothing).
       const double w = property->GetComponentWeight(c);
       m.base[QuantityOffset(Quantity::Density)] = std::isnan(w) ? NAN : w > 0.0 ? 1.f : 0.f;
-      for (int k = 0; k < 3; ++k)
-        m.base[QuantityOffset(Quantity::Albedo) + k] = std::isnan(w) ? 0.f : (float)(w * w);
+      ScaleColour(m, std::isnan(w) ? 0.f : (float)(w * w));
       scene.materials.push_back(std::move(m));
     }
     scene.additiveMaterials = true;
@@ -428,12 +495,12 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
   const MaterialFunctions main = ComponentFunctions(property, component, finite);
   if (vtkImageData* table = TransferFunction2D(property, component); table && proxies.gradient >= 0)
   {
-    Add2DMaterials(table, property, component, proxies, scene); // no default: outside the bands is empty
+    Add2DMaterials(table, property, component, proxies, options, scene); // no default: outside the bands is empty
     scene.defaultMaterial = kNoMaterial;
   }
   else
   {
-    scene.materials.push_back(MakeMaterial("volume", main, property, component, proxies, scene));
+    scene.materials.push_back(MakeMaterial("volume", main, property, component, proxies, options, scene));
     scene.defaultMaterial = 0;
   }
 
@@ -458,7 +525,8 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
       f.gradientOpacity = IsConstantOne(g) ? nullptr : finite.Of(g);
     selector.keys.push_back((float)label);
     selector.materials.push_back((int)scene.materials.size());
-    scene.materials.push_back(MakeMaterial("label " + std::to_string(label), f, property, component, proxies, scene));
+    scene.materials.push_back(
+      MakeMaterial("label " + std::to_string(label), f, property, component, proxies, options, scene));
   }
   if (selector.keys.empty())
     return finite.replaced;
@@ -512,14 +580,24 @@ int ReplaceNonFinite(Scene& scene)
 
 } // namespace
 
-int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene)
+int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
+  const TranslationOptions& options, Scene& scene)
 {
-  const int nodes = TranslateMaterials(property, component, proxies, scene);
+  const int nodes = TranslateMaterials(property, component, proxies, options, scene);
   return nodes + ReplaceNonFinite(scene);
 }
 
+bool AnyMaterialScatters(const Scene& scene)
+{
+  for (const MaterialDesc& m : scene.materials)
+    for (int c = 0; c < 3; ++c)
+      if (m.base[QuantityOffset(Quantity::Albedo) + c] > 0.f)
+        return true;
+  return false;
+}
+
 void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
-  const ProxyLayout& proxies, Scene& scene)
+  const ProxyLayout& proxies, const TranslationOptions& options, Scene& scene)
 {
   if (proxies.labels < 0)
     return;
@@ -529,7 +607,7 @@ void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property,
   m.base[QuantityOffset(Quantity::Density)] = rule["density"].get<float>();
   for (int c = 0; c < 3; ++c)
     m.base[QuantityOffset(Quantity::Albedo) + c] = rule["albedo"][c].get<float>();
-  ApplyShading(property, component, m);
+  ApplyShading(property, component, options, m);
   // A look follows the one label rule (a hidden label shows the volume
   // property): the label leaves the gate that VTK's label functions put it
   // in.
@@ -641,6 +719,7 @@ void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene&
 {
   scene.lights.clear();
   scene.cameraLights.clear();
+  const double diffuse = std::max(property->GetDiffuse(0), 0.0);
   vtkLightCollection* lights = renderer->GetLights();
   lights->InitTraversal();
   while (vtkLight* light = lights->GetNextItem())
@@ -656,7 +735,7 @@ void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene&
     if (!(distance > 0.f))
       continue;
     const double* col = light->GetDiffuseColor();
-    const float scale = kPi * (float)light->GetIntensity();
+    const float scale = kPi * (float)(light->GetIntensity() * diffuse);
     Light l;
     l.L = RGB((float)col[0] * scale, (float)col[1] * scale, (float)col[2] * scale);
     if (light->GetPositional())
@@ -669,6 +748,11 @@ void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene&
     {
       l.type = LightType::Directional;
       l.vector = toLight / distance;
+      // A headlight or camera light leaves from where it is, beside the
+      // camera: with the camera inside the volume, the tissue behind it
+      // does not shadow what it sees (from infinitely far, it would).
+      if (light->LightTypeIsHeadlight() || light->LightTypeIsCameraLight())
+        l.start = Dot(position, l.vector);
     }
     scene.lights.push_back(l);
   }

@@ -22,20 +22,35 @@
 // - The functions are sampled at kTableSize points over the scalar range, as
 //   VTK's own GPU mapper samples them into tables, which keeps midpoints,
 //   sharpness and log scales.
-// - Shade off: volume scattering only (isotropic phase). Shade on: surface
-//   scattering with probability kShadedSurfaceProbability on the gradient
-//   normal; roughness (2 / (SpecularPower + 2))^(1/4) (the Blinn-Phong
-//   exponent's GGX equivalent), 1 when Specular is 0. Ambient is a constant
-//   environment light of that radiance. Diffuse is not used: the albedo is
-//   the colour.
+// - Shade off, as VTK's mappers: the colour glows unlit (emission sigma_t *
+//   colour, albedo 0: emission and absorption, VTK's compositing); with
+//   TranslationOptions::unshadedScatters the colour is instead the albedo
+//   of volume scattering (isotropic phase), lit by the lights. Shade on:
+//   surface scattering with probability kShadedSurfaceProbability on the
+//   gradient normal (1 with TranslationOptions::localLighting, as VTK
+//   shades every sample on its gradient); roughness (2 / (SpecularPower + 2))^(1/4) (the
+//   Blinn-Phong exponent's GGX equivalent), 1 when Specular is 0. Ambient is
+//   a constant environment light of that radiance.
 // - Lights: a directional light (scene light, headlight, camera light)
-//   gives irradiance pi * intensity * colour, so that a white Lambertian
-//   surface facing it shows intensity * colour, as VTK's diffuse shading
-//   does; a positional light gives the same irradiance at its focal point.
+//   gives irradiance pi * intensity * colour * Diffuse, so that a white
+//   Lambertian surface facing it shows intensity * colour * Diffuse, as
+//   VTK's diffuse shading does; a positional light gives the same
+//   irradiance at its focal point.
+// - Blend mode ISOSURFACE: surfaces where the scalars cross the property's
+//   iso-values (TranslationOptions::isoValues), each crossing as opaque as
+//   a slab isoSampleDistance thick at the iso-value's opacity (an optical
+//   depth -ln(1 - alpha) * isoSampleDistance / d across it, as VTK's GPU
+//   mapper composites one sample per crossing): extinction only in a band
+//   of half-width kIsoBandFraction
+//   of the scalar range around each iso-value, proportional to the
+//   gradient magnitude there (so that a ray crossing the band along the
+//   normal meets that optical depth, whatever the gradient), with surface
+//   probability 1 when shaded.
 #pragma once
 
 #include <array>
 #include <string>
+#include <vector>
 
 #include "label_materials.h"
 #include "scene.h"
@@ -49,6 +64,22 @@ namespace mmrtm
 
 constexpr int kTableSize = 256;
 constexpr float kShadedSurfaceProbability = 0.8f;
+constexpr float kIsoBandFraction = 1.f / 512.f;
+
+// What the mapper adds to the property's description.
+struct TranslationOptions
+{
+  bool unshadedScatters = false; // Shade off scatters the lights (else it glows, as VTK)
+  bool localLighting = false;    // VTK's local lighting: Shade on is a surface at every point
+  bool isosurface = false;       // ISOSURFACE blend: surfaces at isoValues only
+  std::vector<double> isoValues;
+  float isoSampleDistance = 1.f; // a crossing is as opaque as this length at the iso-value's opacity
+  bool operator==(const TranslationOptions& o) const
+  {
+    return unshadedScatters == o.unshadedScatters && localLighting == o.localLighting && isosurface == o.isosurface &&
+      isoValues == o.isoValues && isoSampleDistance == o.isoSampleDistance;
+  }
+};
 
 // Whether component `component`'s gradient opacity is in use (enabled and
 // not constant 1), so that the gradient-magnitude proxy is needed.
@@ -97,7 +128,14 @@ struct ProxyLayout
 // NaN position is dropped), any other NaN reaching the scene (a component
 // weight) is 0; returns how many there were, for the caller to warn about.
 // (A NaN unit distance is VTK's default 1, without a warning.)
-int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies, Scene& scene);
+// With isosurface options and no gradient proxy in the layout, or with
+// several components, the iso-values are not used (the caller warns).
+int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
+  const TranslationOptions& options, Scene& scene);
+
+// Whether some material of the scene scatters light (an albedo above 0);
+// a scene whose materials only glow needs no light and no bounce.
+bool AnyMaterialScatters(const Scene& scene);
 
 // Gives label `label` the material of `look` by the one label rule
 // (LabelMaterial: density and albedo), shaded as the property's component
@@ -107,7 +145,7 @@ int SetMaterialsFromProperty(vtkVolumeProperty* property, int component, const P
 // functions show, as for a label without a look.
 // Throws InputError for a look out of range.
 void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property, int component,
-  const ProxyLayout& proxies, Scene& scene);
+  const ProxyLayout& proxies, const TranslationOptions& options, Scene& scene);
 
 // Gives label `label`'s material (made by SetMaterialsFromProperty) the
 // surface and phase parameters VTK's label functions cannot say: a JSON

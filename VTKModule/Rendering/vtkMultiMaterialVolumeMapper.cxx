@@ -20,6 +20,7 @@
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
 #include <vtkColorTransferFunction.h>
+#include <vtkContourValues.h>
 #include <vtkImageData.h>
 #include <vtkInformation.h>
 #include <vtkInformationObjectBaseVectorKey.h>
@@ -101,6 +102,7 @@ struct vtkMultiMaterialVolumeMapper::InputState
   {
     vtkVolumeProperty* Property = nullptr;
     vtkMTimeType PropertyTime = 0, MultiMaterialTime = 0, LabelMaterialsTime = 0;
+    mmrtm::TranslationOptions Options; // the mapper's: unshaded scattering, isosurfaces
   } Materials;
 
   struct ViewInputs
@@ -213,9 +215,9 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::unique_ptr<Pass> InFlight;
   std::unique_ptr<mmrtm::Film> Shown;
 
-  // The last exposure edit: the mapper's modification time before it (as
-  // TracingMTime gave it) and after.
-  vtkMTimeType ExposureEditBefore = 0, ExposureEditAfter = 0;
+  // The last display edit (exposure, tone mapping): the mapper's
+  // modification time before it (as TracingMTime gave it) and after.
+  vtkMTimeType DisplayEditBefore = 0, DisplayEditAfter = 0;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0, GridRefits = 0;
   // After a Scene.Build: what it did to the majorant grid.
@@ -248,6 +250,12 @@ struct vtkMultiMaterialVolumeMapper::Internals
 
 namespace
 {
+// Global illumination off: the shadow rays' extinction scale. The tracer
+// takes a scale above 0; at this one a shadow ray through the densest
+// tissue the translation makes (an optical depth of 64 per voxel) over
+// 1000 voxels transmits 0.94, everything lighter nearly 1.
+constexpr float kLocalLightingShadowScale = 1e-6f;
+
 // The property's modification time without the edits of its colour
 // functions: what the planted defect MapperColorRefit sees.
 vtkMTimeType MTimeWithoutColours(vtkVolumeProperty* p)
@@ -486,23 +494,48 @@ void vtkMultiMaterialVolumeMapper::ResetAccumulation()
 void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
 {
   exposure = std::max(0.0, exposure);
-  if (exposure == this->Exposure)
-    return;
+  if (exposure != this->Exposure)
+    this->DisplayEdit([&] { this->Exposure = exposure; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
+{
+  mode = std::clamp(mode, static_cast<int>(TONE_MAPPING_OFF), static_cast<int>(FILMIC_TONE_MAPPING));
+  if (mode != this->ToneMapping)
+    this->DisplayEdit([&] { this->ToneMapping = mode; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetLookToVTK()
+{
+  this->SetToneMappingToOff();
+  this->SetUnshadedScattering(0);
+}
+
+void vtkMultiMaterialVolumeMapper::SetLookToFilmic()
+{
+  this->SetToneMappingToFilmic();
+  this->SetUnshadedScattering(1);
+}
+
+template <class Edit>
+void vtkMultiMaterialVolumeMapper::DisplayEdit(Edit edit)
+{
   Internals& in = *this->Internal;
   const vtkMTimeType before = this->TracingMTime();
-  this->Exposure = exposure;
+  edit();
   this->Modified();
-  in.ExposureEditBefore = before;
-  in.ExposureEditAfter = this->GetMTime();
+  in.DisplayEditBefore = before;
+  in.DisplayEditAfter = this->GetMTime();
 }
 
 vtkMTimeType vtkMultiMaterialVolumeMapper::TracingMTime()
 {
-  // The mapper's modification time as far as tracing goes: an exposure
-  // edit (only DrawFilm reads it) with nothing modified after it leaves the
-  // time it had before, so the accumulation goes on.
+  // The mapper's modification time as far as tracing goes: a display edit
+  // (exposure, tone mapping: only DrawFilm reads them) with nothing
+  // modified after it leaves the time it had before, so the accumulation
+  // goes on.
   const vtkMTimeType t = this->GetMTime();
-  return t == this->Internal->ExposureEditAfter ? this->Internal->ExposureEditBefore : t;
+  return t == this->Internal->DisplayEditAfter ? this->Internal->DisplayEditBefore : t;
 }
 
 void vtkMultiMaterialVolumeMapper::SetMaskInput(vtkImageData* mask)
@@ -886,8 +919,6 @@ bool vtkMultiMaterialVolumeMapper::ValidateInputs(vtkRenderer* ren, vtkVolume* v
     vtkErrorMacro("Render: " << (this->GetInput() ? "the vtkVolume has no volume property" : "no input"));
     return false;
   }
-  if (in.Warn("blend mode", this->BlendMode == vtkVolumeMapper::ISOSURFACE_BLEND))
-    vtkWarningMacro("isosurface blending is not supported; rendering as composite");
   ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
   return viewport[0] > 0 && viewport[1] > 0;
 }
@@ -914,8 +945,34 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   now.Proxies.Independent = independent && components > 1 ? std::min(components, 4) : 0;
   // 4 dependent components fill the 4 proxies: no room for a gradient.
   const bool labels = in.Mask && this->MaskType == LABELMAP;
+  // Isosurfaces of one component (the others render as composite).
+  const bool isosurface = this->BlendMode == vtkVolumeMapper::ISOSURFACE_BLEND && !in.MultiMaterial;
+  const bool isosurfaceComponents = isosurface && (now.Proxies.Dependent || now.Proxies.Independent);
+  if (in.Warn("isosurface with components", isosurfaceComponents))
+    vtkWarningMacro("isosurface blending of " << components << " components is not supported; rendering as composite");
+  now.Materials.Options.isosurface = isosurface && !isosurfaceComponents;
+  if (now.Materials.Options.isosurface)
+  {
+    vtkContourValues* values = property->GetIsoSurfaceValues();
+    for (int i = 0; i < values->GetNumberOfContours(); ++i)
+      now.Materials.Options.isoValues.push_back(values->GetValue(i));
+    // VTK's GPU mapper composites an iso-value's opacity once per crossing,
+    // corrected from the unit distance to its sample distance: the
+    // smallest voxel spacing, or SampleDistance when the distances do not
+    // adapt.
+    const double* spacing = now.Proxies.Data->GetSpacing();
+    now.Materials.Options.isoSampleDistance = !this->AutoAdjustSampleDistances && this->SampleDistance > 0.f
+      ? this->SampleDistance
+      : static_cast<float>(std::min({ std::abs(spacing[0]), std::abs(spacing[1]), std::abs(spacing[2]) }));
+  }
+  // The projections show the colour they read as the albedo.
+  const bool projection = this->BlendMode == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND ||
+    this->BlendMode == vtkVolumeMapper::MINIMUM_INTENSITY_BLEND ||
+    this->BlendMode == vtkVolumeMapper::AVERAGE_INTENSITY_BLEND || this->BlendMode == vtkVolumeMapper::ADDITIVE_BLEND;
+  now.Materials.Options.unshadedScatters = this->UnshadedScattering || projection;
+  now.Materials.Options.localLighting = !this->GlobalIllumination;
   now.Proxies.NeedGradient = !in.MultiMaterial && now.Proxies.Dependent != 4 && !now.Proxies.Independent &&
-    mmrtm::NeedsGradientProxy(property, 0, labels);
+    (mmrtm::NeedsGradientProxy(property, 0, labels) || now.Materials.Options.isosurface);
   now.Proxies.ComponentGradients = 0;
   for (int c = 0; c < now.Proxies.Independent; ++c)
     now.Proxies.ComponentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
@@ -1000,7 +1057,8 @@ vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince
   c.Description = description && now.Materials.MultiMaterialTime != built.Materials.MultiMaterialTime;
   c.Materials = !description &&
     (now.Materials.Property != built.Materials.Property || now.Materials.PropertyTime != built.Materials.PropertyTime ||
-      now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime);
+      now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime ||
+      !(now.Materials.Options == built.Materials.Options));
   c.View = !SameView(now.View.Values, built.View.Values) || now.View.Depth != built.View.Depth ||
     now.View.TracingTime != built.View.TracingTime;
   return c;
@@ -1043,14 +1101,15 @@ void vtkMultiMaterialVolumeMapper::UpdateMaterials(const InputState& now)
 {
   // The transfer functions translated again (the scene's build refits).
   Internals& in = *this->Internal;
-  if (const int nonFinite = mmrtm::SetMaterialsFromProperty(now.Materials.Property, 0, in.Layout, in.Scene))
+  if (const int nonFinite =
+        mmrtm::SetMaterialsFromProperty(now.Materials.Property, 0, in.Layout, now.Materials.Options, in.Scene))
     vtkWarningMacro(<< "the volume property holds " << nonFinite
                     << " value(s) that are not finite (NaN in a transfer function or a component "
                        "weight); they were read as 0");
   if (in.Layout.labels >= 0)
   {
     for (const auto& [label, look] : in.LabelLooks)
-      mmrtm::SetLabelLook(label, look, now.Materials.Property, 0, in.Layout, in.Scene);
+      mmrtm::SetLabelLook(label, look, now.Materials.Property, 0, in.Layout, now.Materials.Options, in.Scene);
     for (const auto& [label, json] : in.LabelMaterialParameters)
       mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
   }
@@ -1086,8 +1145,13 @@ void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, 
   rs.threads = this->NumberOfThreads;
   rs.exposure = static_cast<float>(this->Exposure);
   rs.integrator.seed = static_cast<uint64_t>(this->Seed);
-  rs.integrator.shadowExtinctionScale = static_cast<float>(this->ShadowExtinctionScale);
-  rs.integrator.maxBounces = this->MaximumBounces;
+  // Local lighting: shadow rays see (almost) nothing, and light scatters once.
+  rs.integrator.shadowExtinctionScale =
+    this->GlobalIllumination ? static_cast<float>(this->ShadowExtinctionScale) : kLocalLightingShadowScale;
+  // Materials that only glow (unshaded, as VTK) need no light and no bounce.
+  rs.integrator.maxBounces = !mmrtm::AnyMaterialScatters(in.Scene) ? 0
+    : this->GlobalIllumination                                     ? this->MaximumBounces
+                                                                   : 1;
   rs.integrator.sampler = this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
   rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
     : this->Accelerator == NO_ACCELERATOR              ? mmrtm::MajorantKind::Global
@@ -1533,8 +1597,10 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
   const int width = film.Width(), height = film.Height();
   // A projection's film holds VTK's colours made linear: no curve.
   const mmrtm::RenderSettings& rs = this->Internal->Scene.render;
-  const mmrtm::ToneMapper toneMapper =
-    rs.integrator.projection.mode != mmrtm::IntensityProjection::None ? mmrtm::ToneMapper::Clamp : rs.toneMapper;
+  const mmrtm::ToneMapper toneMapper = rs.integrator.projection.mode != mmrtm::IntensityProjection::None
+    ? mmrtm::ToneMapper::Clamp
+    : this->ToneMapping == FILMIC_TONE_MAPPING ? mmrtm::ToneMapper::Filmic
+                                               : mmrtm::ToneMapper::Off;
   std::vector<uint8_t> rgba = film.ToneMapped(static_cast<float>(this->Exposure), toneMapper, 4);
   const size_t row = 4 * static_cast<size_t>(width);
   for (int y = 0; y < height / 2; ++y)

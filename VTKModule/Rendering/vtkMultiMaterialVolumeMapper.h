@@ -34,11 +34,13 @@
  *
  * Clipping planes (world space) and cropping (data space, every region
  * set) limit what is seen. The maximum, minimum and average intensity and
- * additive blend modes are projections, as VTK's GPU mapper computes them.
- * Not supported yet (a warning is given once per cause): isosurface
- * blending (rendered as composite), more than four independent
- * components, gradient opacity of independent components beyond the four
- * proxies.
+ * additive blend modes are projections, as VTK's GPU mapper computes them;
+ * the isosurface blend mode traces surfaces at the property's iso-values
+ * (each as opaque as the scalar opacity there), lit as the rest. Not
+ * supported yet (a warning is given once per cause): isosurfaces of data
+ * with several components (rendered as composite), more than four
+ * independent components, gradient opacity of independent components
+ * beyond the four proxies.
  *
  * @sa vtkVolumeMapper vtkFixedPointVolumeRayCastMapper
  */
@@ -210,6 +212,67 @@ public:
    */
   virtual void SetExposure(double exposure);
   vtkGetMacro(Exposure, double);
+  ///@}
+
+  ///@{
+  /**
+   * How the accumulated radiance becomes pixel values. TONE_MAPPING_OFF
+   * (the default): the value itself, clipped at 1, as VTK's mappers write
+   * their colours (the colour functions hold display values, so a white
+   * surface facing VTK's headlight shows its colour times Diffuse). FILMIC:
+   * the ACES filmic curve and the sRGB encoding, soft highlights for scenes
+   * lit beyond 1 (environment maps, several lights, emission). Like the
+   * exposure, a change redraws the samples accumulated so far. The
+   * projection blend modes show VTK's colours either way.
+   */
+  enum ToneMappings
+  {
+    TONE_MAPPING_OFF = 0,
+    FILMIC_TONE_MAPPING = 1
+  };
+  virtual void SetToneMapping(int mode);
+  vtkGetMacro(ToneMapping, int);
+  void SetToneMappingToOff() { this->SetToneMapping(TONE_MAPPING_OFF); }
+  void SetToneMappingToFilmic() { this->SetToneMapping(FILMIC_TONE_MAPPING); }
+  ///@}
+
+  ///@{
+  /**
+   * What a volume property's Shade off means. Off (the default), as in
+   * VTK's mappers: the colour glows, unlit (emission and absorption: no
+   * light, no shadow, no bounce). On: the colour is the albedo of volume
+   * scattering (an isotropic phase function), lit by the renderer's lights
+   * with shadows and multiple scattering. Shade on is lit either way (a
+   * surface on the gradient normal). A change translates the property again.
+   */
+  vtkSetMacro(UnshadedScattering, vtkTypeBool);
+  vtkGetMacro(UnshadedScattering, vtkTypeBool);
+  vtkBooleanMacro(UnshadedScattering, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Global illumination (default on): the path tracer's light transport,
+   * shadows (shadow rays through the volume) and light scattered many
+   * times (up to MaximumBounces). Off: VTK's local lighting, each point lit
+   * by the lights directly, unshadowed, light scattered once, which is what
+   * VTK's mappers compute with shading on: the colours come within VTK's
+   * own (translucent tissue no longer darkened by the light's way in).
+   */
+  vtkSetMacro(GlobalIllumination, vtkTypeBool);
+  vtkGetMacro(GlobalIllumination, vtkTypeBool);
+  vtkBooleanMacro(GlobalIllumination, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Looks: SetLookToVTK (the default) gives VTK's colours: tone mapping
+   * off, unshaded volumes glow. SetLookToFilmic is the path tracer's own:
+   * filmic tone mapping, unshaded volumes scatter the lights. Neither
+   * changes GlobalIllumination.
+   */
+  void SetLookToVTK();
+  void SetLookToFilmic();
   ///@}
 
   ///@{
@@ -470,6 +533,9 @@ protected:
   int NumberOfThreads = 0;
   int Backend = AUTO;
   double Exposure = 1.0;
+  int ToneMapping = TONE_MAPPING_OFF;
+  vtkTypeBool UnshadedScattering = 0;
+  vtkTypeBool GlobalIllumination = 1;
   double NoiseTarget = 0.0;
   vtkTypeBool AsynchronousRefinement = 0;
   int Accelerator = OCTREE;
@@ -522,6 +588,10 @@ private:
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
   vtkMTimeType TracingMTime();
+  // Applies `edit` to a setting only DrawFilm reads (exposure, tone
+  // mapping): the accumulation goes on (TracingMTime).
+  template <class Edit>
+  void DisplayEdit(Edit edit);
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;

@@ -584,8 +584,8 @@ class Parser {
       a.grid.threads = r.threads;
       r.exposure = NumberOr(rj, "exposure", r.exposure, w);
       const std::string tm = StringOr(rj, "tone_mapper", "filmic", w);
-      if (tm != "filmic" && tm != "clamp") Fail(w + ".tone_mapper", "expected filmic or clamp");
-      r.toneMapper = tm == "clamp" ? ToneMapper::Clamp : ToneMapper::Filmic;
+      if (tm != "filmic" && tm != "clamp" && tm != "off") Fail(w + ".tone_mapper", "expected filmic, clamp or off");
+      r.toneMapper = tm == "clamp" ? ToneMapper::Clamp : tm == "off" ? ToneMapper::Off : ToneMapper::Filmic;
     }
   }
 

@@ -11,7 +11,7 @@ namespace {
 // differ between equal values and make every table look changed).
 static_assert(sizeof(TransferFunctionView) == 4 + 4 + 4 * sizeof(void*) + 4 * 4);
 static_assert(sizeof(CoefficientBinding) == 8);
-static_assert(sizeof(Light) == 4 + sizeof(Vec3) + sizeof(RGB));
+static_assert(sizeof(Light) == 4 + sizeof(Vec3) + sizeof(RGB) + sizeof(float));
 static_assert(sizeof(MaterialView) == sizeof(float) * kCoefficientFloats + 3 * sizeof(int));
 
 // The scene's tables as one byte string: every Tables array, with the

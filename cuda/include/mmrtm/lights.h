@@ -70,6 +70,10 @@ struct Light {
   uint8_t padding[3] = {};  // explicit: equal lights have equal bytes (scene_uploads.h)
   Vec3 vector;              // directional: unit direction toward the light; point: position
   RGB L;                    // directional: irradiance at normal incidence; point: intensity
+  // Directional: the plane dot(x, vector) = start that the light leaves
+  // from (a headlight leaves from the camera: what is behind the camera
+  // neither shadows nor receives it); kInfinity: from infinitely far.
+  float start = kInfinity;
 };
 
 struct LightSample {
@@ -87,7 +91,8 @@ MMRTM_CPU_GPU inline LightSample SampleLight(const Light& light, const Environme
     case LightType::Directional:
       s.wi = light.vector;
       s.L = light.L;
-      s.pdf = 1.f;
+      s.distance = light.start - Dot(p, light.vector);  // kInfinity when it has no start
+      s.pdf = s.distance > 0.f ? 1.f : 0.f;             // behind its start: no light
       break;
     case LightType::Point: {
       Vec3 d = light.vector - p;

@@ -8,8 +8,10 @@
 namespace mmrtm {
 
 enum class ToneMapper : uint8_t {
-  Clamp,  // linear, clipped at 1
-  Filmic  // ACES fit of Narkowicz (2015): soft highlights (the default)
+  Clamp,   // linear, clipped at 1, sRGB-encoded
+  Filmic,  // ACES fit of Narkowicz (2015): soft highlights, sRGB-encoded (the default)
+  Off      // the value itself, clipped at 1: as VTK's mappers write colours
+           // (their colour functions hold display values, not linear ones)
 };
 
 MMRTM_CPU_GPU inline float LinearToSRGB(float v) {
@@ -34,7 +36,7 @@ MMRTM_CPU_GPU inline void ToneMapPixel(RGB L, float exposure, ToneMapper op, uin
     float v = L[c] * exposure;
     if (!(v >= 0.f)) v = 0.f;  // NaN and negatives to black
     if (op == ToneMapper::Filmic) v = FilmicCurve(v);
-    out[c] = (uint8_t)(LinearToSRGB(v) * 255.f + 0.5f);
+    out[c] = (uint8_t)((op == ToneMapper::Off ? Clamp(v, 0.f, 1.f) : LinearToSRGB(v)) * 255.f + 0.5f);
   }
 }
 
