@@ -1,7 +1,8 @@
 """The mapper reads the caller's voxels where they are (Documentation/vtk-mapper.md,
 "What the mapper holds"): a volume that Slicer, ParaView or a script holds
 is not held a second time, and an edit of it reaches the image through
-Modified() as any data change does.
+Modified() as any data change does. vtkMultiMaterialVolumeReader's output
+is its loaded volume itself.
 
 Run by ctest under Testing/headless.sh with /usr/bin/python3 (python3-vtk9)
 and the build tree's mmrtm package on PYTHONPATH. The large volume is made
@@ -21,7 +22,7 @@ from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, 
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
 
-from mmrtm import vtkMultiMaterialVolumeMapper
+from mmrtm import vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 BACKGROUND = (0.1, 0.1, 0.15)
@@ -161,6 +162,29 @@ class InPlaceVoxelsTest(unittest.TestCase):
         view.render()
         self.assertEqual(view.builds(), 2, "a modified array rebuilds the scene")
         self.assertLess(view.coverage(), 0.01, "the edit (all air) is not in the image")
+
+    def test_the_reader_holds_its_volume_once(self):
+        # What this catches: a reader that keeps the loaded volume and
+        # copies it into its output (2.0 x the voxel bytes), or a loader
+        # that copies out of its file reader's array (a peak of 2.0 x).
+        warm = vtkMultiMaterialVolumeReader()  # the loader's libraries, loaded once
+        warm.SetFileName(os.path.join(DATA, "ct_head_headsq.nrrd"))
+        warm.Update()
+        held = resident_bytes()
+        reset_peak()
+        reader = vtkMultiMaterialVolumeReader()
+        reader.SetFileName(os.path.join(DATA, "frogtissue.mhd"))  # 30.5 MiB of uint8
+        reader.Update()
+        scalars = reader.GetOutput().GetPointData().GetScalars()
+        voxel_bytes = scalars.GetNumberOfValues() * scalars.GetDataTypeSize()
+        rise = peak_resident_bytes() - held
+        self.assertLessEqual(rise, 1.5 * voxel_bytes,
+                             "reading %d MiB raised the peak by %.2f x" % (voxel_bytes >> 20, rise / voxel_bytes))
+        first = [scalars.GetValue(i) for i in range(0, scalars.GetNumberOfValues(), 99991)]
+        reader.Modified()  # executes again: the file is read again, the same voxels come out
+        reader.Update()
+        again = reader.GetOutput().GetPointData().GetScalars()
+        self.assertEqual([again.GetValue(i) for i in range(0, again.GetNumberOfValues(), 99991)], first)
 
     def test_nan_voxels_are_replaced_without_writing_the_callers_array(self):
         image = head_ct()
