@@ -59,6 +59,7 @@ HostVolume Resample(const HostVolume& in, int n) {
   out.type = in.type;
   out.dims = {n, n, n};
   out.voxels.resize((size_t)n * n * n * VoxelTypeSize(in.type));
+  uint8_t* bytes = out.voxels.MutableData();
   const VolumeView v = in.View();
   Affine3 scale;  // new index -> old index
   for (int a = 0; a < 3; ++a) scale.m[a][a] = (float)(in.dims[a] - 1) / (float)(n - 1);
@@ -69,13 +70,13 @@ HostVolume Resample(const HostVolume& in, int n) {
         const float value = v.SampleIndex(scale.ApplyPoint({(float)x, (float)y, (float)z}));
         const size_t i = x + (size_t)n * (y + (size_t)n * z);
         if (in.type == VoxelType::Int16)
-          reinterpret_cast<int16_t*>(out.voxels.data())[i] = (int16_t)std::lround(value);
+          reinterpret_cast<int16_t*>(bytes)[i] = (int16_t)std::lround(value);
         else if (in.type == VoxelType::UInt16)
-          reinterpret_cast<uint16_t*>(out.voxels.data())[i] = (uint16_t)std::lround(value);
+          reinterpret_cast<uint16_t*>(bytes)[i] = (uint16_t)std::lround(value);
         else if (in.type == VoxelType::UInt8)
-          out.voxels[i] = (uint8_t)std::lround(value);
+          bytes[i] = (uint8_t)std::lround(value);
         else
-          reinterpret_cast<float*>(out.voxels.data())[i] = value;
+          reinterpret_cast<float*>(bytes)[i] = value;
       }
   return out;
 }

@@ -185,7 +185,7 @@ TEST(GpuBackend, AfterEachEditTheKeptDeviceSceneRendersAsAFreshUpload) {
       {"voxels edited in place",
        [&] {
          HostVolume& v = scene.proxies[0];
-         auto* voxels = reinterpret_cast<int16_t*>(v.voxels.data());
+         auto* voxels = reinterpret_cast<int16_t*>(v.voxels.MutableData());
          ASSERT_EQ(v.type, VoxelType::Int16);
          for (size_t i = 0; i < v.voxels.size() / 2; i += 3) voxels[i] = 1500;
          scene.MarkDataModified();

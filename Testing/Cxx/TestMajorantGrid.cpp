@@ -504,7 +504,7 @@ TEST(LeafSummaries, LeavesShareTheirSummaries) {
 // Writes `value` into the voxels [lo, hi] of the scene's 64 x 64 x N int16
 // proxy 0 (ct_head_headsq), as an editing tool does before it marks the region.
 void PaintBlock(Scene& scene, const std::array<int, 3>& lo, const std::array<int, 3>& hi, int16_t value) {
-  int16_t* voxels = reinterpret_cast<int16_t*>(scene.proxies[0].voxels.data());
+  int16_t* voxels = reinterpret_cast<int16_t*>(scene.proxies[0].voxels.MutableData());
   for (int z = lo[2]; z <= hi[2]; ++z)
     for (int y = lo[1]; y <= hi[1]; ++y)
       for (int x = lo[0]; x <= hi[0]; ++x) voxels[x + 64 * (y + 64 * z)] = value;

@@ -19,7 +19,7 @@ inline HostVolume MakeVolume(int nx, int ny, int nz, const std::function<float(i
   v.type = VoxelType::Float32;
   v.dims = {nx, ny, nz};
   v.voxels.resize((size_t)nx * ny * nz * sizeof(float));
-  float* p = reinterpret_cast<float*>(v.voxels.data());
+  float* p = reinterpret_cast<float*>(v.voxels.MutableData());
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) p[i + (size_t)nx * (j + (size_t)ny * k)] = f(i, j, k);

@@ -96,13 +96,13 @@ TEST(SceneUploads, EachKindOfEditSendsWhatItChangedAndNothingElse) {
        {false, false, false, false, true}},
       {"voxels edited in place",
        [](Scene& s) {
-         reinterpret_cast<float*>(s.proxies[0].voxels.data())[100] = 59.f;
+         reinterpret_cast<float*>(s.proxies[0].voxels.MutableData())[100] = 59.f;
          s.MarkDataModified();
        },
        {true, true, true, false, false}},
       {"voxels of a region edited",
        [](Scene& s) {
-         reinterpret_cast<float*>(s.proxies[0].voxels.data())[100] = 59.f;
+         reinterpret_cast<float*>(s.proxies[0].voxels.MutableData())[100] = 59.f;
          s.MarkRegionModified({4, 4, 0}, {4, 4, 0});
        },
        {true, true, true, false, false}},

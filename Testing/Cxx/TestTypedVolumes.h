@@ -31,7 +31,7 @@ HostVolume MakeTyped(std::array<int, 3> dims, const std::function<double(int, in
   v.dims = dims;
   v.indexToWorld = indexToWorld;
   v.voxels.resize((size_t)v.VoxelCount() * sizeof(T));
-  T* p = reinterpret_cast<T*>(v.voxels.data());
+  T* p = reinterpret_cast<T*>(v.voxels.MutableData());
   for (int k = 0; k < dims[2]; ++k)
     for (int j = 0; j < dims[1]; ++j)
       for (int i = 0; i < dims[0]; ++i) p[i + (size_t)dims[0] * (j + (size_t)dims[1] * k)] = (T)f(i, j, k);

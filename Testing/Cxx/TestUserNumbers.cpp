@@ -110,7 +110,7 @@ TEST(UserNumbers, NonFiniteGeometryIsAnError) {
   s.indexToWorld.m[0][0] = 0.f;  // a zero spacing
   EXPECT_THROW(s.Validate(), InputError);
   HostVolume n = test::MakeConstantVolume(4, 1.f);
-  reinterpret_cast<float*>(n.voxels.data())[5] = std::nanf("");
+  reinterpret_cast<float*>(n.voxels.MutableData())[5] = std::nanf("");
   try {
     n.Validate();
     ADD_FAILURE() << "a NaN voxel was accepted";

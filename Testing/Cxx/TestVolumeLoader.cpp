@@ -126,6 +126,8 @@ TEST(VolumeLoader, NrrdCraniumHeadCt) {
   const auto range = v.ValueRange();
   EXPECT_EQ(range[0], -1024.f);
   EXPECT_EQ(range[1], 2986.f);
+  // int16 as stored: the reader's array is the volume's buffer (no second copy).
+  EXPECT_TRUE(v.voxels.IsBorrowed());
 }
 
 TEST(VolumeLoader, NrrdHeadsqSpacingsField) {
@@ -160,6 +162,7 @@ TEST(VolumeLoader, NiftiBonsaiUInt8) {
   const HostVolume v = LoadVolume(Data("bonsai.nii.gz"));
   EXPECT_EQ(v.dims, (std::array<int, 3>{256, 256, 256}));
   EXPECT_EQ(v.type, VoxelType::UInt8);
+  EXPECT_TRUE(v.voxels.IsBorrowed());  // the reader's array, taken over
   EXPECT_EQ(ValueAt(v, 128, 128, 128), 69.f);
   // qform/sform: RAS (-127, -127, -128) at index 0, identity axes.
   ExpectWorld(v, {0, 0, 0}, {127, 127, -128});
@@ -171,6 +174,7 @@ TEST(VolumeLoader, NiftiMrHeadSlopeGivesFloat) {
   EXPECT_EQ(v.dims, (std::array<int, 3>{160, 232, 160}));
   // uint8 * scl_slope 2.007843 is not integer-valued: float32.
   EXPECT_EQ(v.type, VoxelType::Float32);
+  EXPECT_FALSE(v.voxels.IsBorrowed());  // rescaled: a buffer of its own
   EXPECT_NEAR(ValueAt(v, 80, 116, 80), 51 * 2.007843255996704, 1e-3);
   EXPECT_NEAR(v.ValueRange()[1], 255 * 2.007843255996704, 1e-3);
   // sform rows (1,0,0,-388.26) (0,0.898437,0,-81.12) (0,0,0.898437,405.421) in RAS.

@@ -31,7 +31,7 @@ mmrtm::HostVolume SyntheticVolume(const std::string& path, const std::string& na
   v.type = mmrtm::VoxelType::UInt16;
   v.dims = {6, 6, 6};
   v.voxels.resize(6 * 6 * 6 * sizeof(uint16_t));
-  auto* p = reinterpret_cast<uint16_t*>(v.voxels.data());
+  auto* p = reinterpret_cast<uint16_t*>(v.voxels.MutableData());
   for (int i = 0; i < 216; ++i) p[i] = uint16_t(path.find("label") != std::string::npos ? i % 8 : i * 14);
   v.indexToWorld = mmrtm::IndexToWorld({0, 0, 0}, {1, 1, 1}, {1, 0, 0, 0, 1, 0, 0, 0, 1});
   return v;

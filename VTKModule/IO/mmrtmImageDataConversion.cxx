@@ -14,14 +14,15 @@ namespace mmrtm
 namespace
 {
 
-// One component of an interleaved array, as a contiguous copy.
+// One component of an interleaved array, as a contiguous buffer of its own.
 template <typename T>
-std::vector<T> ExtractComponent(const T* data, int64_t tuples, int components, int component)
+std::vector<uint8_t> ExtractComponent(const T* data, int64_t tuples, int components, int component)
 {
-  std::vector<T> out((size_t)tuples);
+  std::vector<uint8_t> bytes((size_t)tuples * sizeof(T));
+  T* out = reinterpret_cast<T*>(bytes.data());
   for (int64_t i = 0; i < tuples; ++i)
-    out[(size_t)i] = data[i * components + component];
-  return out;
+    out[i] = data[i * components + component];
+  return bytes;
 }
 
 } // namespace
@@ -47,19 +48,30 @@ HostVolume ImageDataToHostVolume(
   if (a->GetNumberOfTuples() != out.VoxelCount())
     throw InputError(name + ": the scalars hold " + std::to_string(a->GetNumberOfTuples()) + " tuples for " +
       std::to_string(out.VoxelCount()) + " points");
-  const SourceType type = SourceTypeOfVtk(a->GetDataType(), name);
   if (components == 1)
   {
-    StoreVoxels(a->GetVoidPointer(0), type, out.VoxelCount(), Rescale{}, out);
+    StoreArrayVoxels(a, out.VoxelCount(), Rescale{}, ArrayHolder::Caller, out, name);
   }
   else
   {
+    // The tracer reads a proxy's voxels contiguously: a component of
+    // interleaved scalars is gathered into a buffer of its own, once, in
+    // its own type when the tracer samples that type natively.
+    const SourceType type = SourceTypeOfVtk(a->GetDataType(), name);
     switch (a->GetDataType())
     {
       vtkTemplateMacro({
-        const auto values =
+        std::vector<uint8_t> values =
           ExtractComponent(static_cast<const VTK_TT*>(a->GetVoidPointer(0)), out.VoxelCount(), components, component);
-        StoreVoxels(values.data(), type, out.VoxelCount(), Rescale{}, out);
+        if (const std::optional<VoxelType> native = NativeVoxelType(type))
+        {
+          out.type = *native;
+          out.voxels = std::move(values);
+        }
+        else
+        {
+          StoreVoxels(values.data(), type, out.VoxelCount(), Rescale{}, out);
+        }
       });
       default:
         throw InputError(name + ": unsupported scalar type");

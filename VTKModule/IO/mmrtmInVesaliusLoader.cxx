@@ -428,12 +428,21 @@ void LoadInVesalius(const std::string& path, HostVolume& out, const VolumeLoadOp
   }
   const uint64_t bytes = (uint64_t)out.VoxelCount() * (uint64_t)typeSize;
   CheckMemoryAvailable(path, 2.0 * (double)bytes, "the voxel matrix");
-  const std::vector<uint8_t> raw = ReadTarMember(path, fs::path(dataName).filename().string(), bytes, true);
+  std::vector<uint8_t> raw = ReadTarMember(path, fs::path(dataName).filename().string(), bytes, true);
   if (raw.size() != bytes)
     throw InputError(path + ": " + dataName + " holds " + std::to_string(raw.size()) + " bytes, expected " +
       std::to_string(bytes) + " for the matrix shape");
   // The .dat is little endian, as is every platform this project builds on.
-  StoreVoxels(raw.data(), type, out.VoxelCount(), Rescale{}, out);
+  // A type the tracer samples as it is keeps the matrix as read (no copy).
+  if (const std::optional<VoxelType> native = NativeVoxelType(type))
+  {
+    out.type = *native;
+    out.voxels = std::move(raw);
+  }
+  else
+  {
+    StoreVoxels(raw.data(), type, out.VoxelCount(), Rescale{}, out);
+  }
   out.indexToWorld = IndexToWorld(
     { 0, (out.dims[1] - 1) * spacing[1], 0 }, { spacing[0], spacing[1], spacing[2] }, { 1, 0, 0, 0, -1, 0, 0, 0, 1 });
 }

@@ -112,24 +112,6 @@ void WithTypedPointer(SourceType type, const void* data, F&& f)
   }
 }
 
-// The types the tracer stores as they are (DESIGN.md rule 3).
-std::optional<VoxelType> NativeVoxelType(SourceType t)
-{
-  switch (t)
-  {
-    case SourceType::UInt8:
-      return VoxelType::UInt8;
-    case SourceType::Int16:
-      return VoxelType::Int16;
-    case SourceType::UInt16:
-      return VoxelType::UInt16;
-    case SourceType::Float32:
-      return VoxelType::Float32;
-    default:
-      return std::nullopt;
-  }
-}
-
 struct ValueStats
 {
   bool allIntegers = true;
@@ -176,6 +158,23 @@ void ConvertValues(const In* in, int64_t n, Rescale r, uint8_t* outBytes)
 
 } // namespace
 
+std::optional<VoxelType> NativeVoxelType(SourceType t)
+{
+  switch (t)
+  {
+    case SourceType::UInt8:
+      return VoxelType::UInt8;
+    case SourceType::Int16:
+      return VoxelType::Int16;
+    case SourceType::UInt16:
+      return VoxelType::UInt16;
+    case SourceType::Float32:
+      return VoxelType::Float32;
+    default:
+      return std::nullopt;
+  }
+}
+
 void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out, bool narrowFloats)
 {
   if (const auto native = NativeVoxelType(type);
@@ -193,22 +192,23 @@ void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale resca
     WithTypedPointer(type, data, [&](auto* p) { target = SmallestExactType(ScanValues(p, count, rescale)); });
   out.type = target;
   out.voxels.resize((size_t)(count * VoxelTypeSize(target)));
+  uint8_t* converted = out.voxels.MutableData();
   WithTypedPointer(type, data,
     [&](auto* p)
     {
       switch (target)
       {
         case VoxelType::UInt8:
-          ConvertValues<uint8_t>(p, count, rescale, out.voxels.data());
+          ConvertValues<uint8_t>(p, count, rescale, converted);
           break;
         case VoxelType::Int16:
-          ConvertValues<int16_t>(p, count, rescale, out.voxels.data());
+          ConvertValues<int16_t>(p, count, rescale, converted);
           break;
         case VoxelType::UInt16:
-          ConvertValues<uint16_t>(p, count, rescale, out.voxels.data());
+          ConvertValues<uint16_t>(p, count, rescale, converted);
           break;
         case VoxelType::Float32:
-          ConvertValues<float>(p, count, rescale, out.voxels.data());
+          ConvertValues<float>(p, count, rescale, converted);
           break;
       }
     });
@@ -219,10 +219,10 @@ void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock)
   const size_t run = (size_t)runVoxels * VoxelTypeSize(v.type), block = run * (size_t)runsPerBlock;
   if (run == 0 || block == 0)
     return;
+  uint8_t* bytes = v.voxels.MutableData();
   for (size_t b = 0; b + block <= v.voxels.size(); b += block)
     for (int64_t lo = 0, hi = runsPerBlock - 1; lo < hi; ++lo, --hi)
-      std::swap_ranges(
-        v.voxels.begin() + b + lo * run, v.voxels.begin() + b + (lo + 1) * run, v.voxels.begin() + b + hi * run);
+      std::swap_ranges(bytes + b + lo * run, bytes + b + (lo + 1) * run, bytes + b + hi * run);
 }
 
 bool IsUncompressedTransferSyntax(const std::string& uid)

@@ -457,7 +457,7 @@ void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions&
   if (values != out.VoxelCount())
     throw InputError(path + ": holds " + std::to_string(values) + " voxels, expected " +
       std::to_string(out.VoxelCount()) + " (truncated or corrupt?)");
-  StoreVoxels(a->GetVoidPointer(0), SourceTypeOfVtk(a->GetDataType(), path), out.VoxelCount(), Rescale{}, out);
+  StoreArrayVoxels(a, out.VoxelCount(), Rescale{}, ArrayHolder::Loader, out, path);
   // vtkImageReader2 (raw encoding only) stores the rows of each slice bottom
   // up when FileLowerLeft is off; undo that in the reader's own row layout,
   // which may differ from ours when it took the x axis for components.

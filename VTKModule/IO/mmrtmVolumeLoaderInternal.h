@@ -87,6 +87,10 @@ struct Rescale
   bool IsIdentity() const { return slope == 1.0 && intercept == 0.0; }
 };
 
+// The voxel type the tracer samples `t` as, when it stores it as it is
+// (DESIGN.md rule 3: uint8, int16, uint16, float32); nullopt otherwise.
+std::optional<VoxelType> NativeVoxelType(SourceType t);
+
 // Stores `count` voxels of `type` into `out` (type and voxels), applying the
 // rescale and choosing the voxel type by the rules in mmrtmVolumeLoader.h.
 // With narrowFloats, float32 voxels that are all integers (a DICOM slice read
@@ -166,7 +170,25 @@ vtkDataArray* VoxelArray(vtkImageData* image, const std::string& path);
 // naming `path` for a type it cannot hold.
 SourceType SourceTypeOfVtk(int vtkType, const std::string& path);
 
-// Copies a single-component image's voxels into `out` (dims, type, voxels).
+// Who holds a VTK array whose voxels a HostVolume reads in place.
+enum class ArrayHolder
+{
+  Loader, // the loader's own reader, which goes when the loader returns: the volume may write into it
+  Caller  // an application's (the mapper's input): never written; a write copies first
+};
+
+// Puts the `count` values of `a` (contiguous, x fastest) into `out` (type
+// and voxels). Values of a type the tracer samples natively that need no
+// rescale are read in place: `out.voxels` borrows the array's memory and
+// holds a reference to the array (mmrtmArrayVoxels.cxx). Any other type, a
+// rescale or an array without VTK's standard memory layout is converted
+// into a buffer of the volume's own (StoreVoxels). `path` names the input in
+// messages.
+void StoreArrayVoxels(
+  vtkDataArray* a, int64_t count, Rescale rescale, ArrayHolder holder, HostVolume& out, const std::string& path);
+
+// A single-component image's voxels in `out` (dims, type, voxels), read in
+// place where StoreArrayVoxels can.
 void StoreImageVoxels(vtkImageData* image, const std::string& path, Rescale rescale, HostVolume& out);
 
 // x_world = origin + D * (spacing * index), with index 0 at the first stored

@@ -1,5 +1,5 @@
 // VTK glue the volume loader's format files share: catching the errors VTK
-// readers report (ReaderErrors, RunReader), taking the voxels out of a
+// readers report (ReaderErrors, RunReader), taking over the voxels of a
 // vtkImageData and reading a vtkImageData's index-to-world geometry.
 #include "mmrtmVolumeLoaderInternal.h"
 
@@ -172,7 +172,8 @@ vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path)
 {
   ReaderErrors errors(reader);
   // The header first: a volume too large for this machine is refused before
-  // the reader allocates it (its buffer and our copy live together).
+  // the reader allocates it (counted as its buffer and a converted copy,
+  // which live together where the voxels need converting).
   reader->UpdateInformation();
   errors.ThrowIfFailed(path);
   if (vtkInformation* info = reader->GetOutputInformation(0);
@@ -254,7 +255,7 @@ void StoreImageVoxels(vtkImageData* image, const std::string& path, Rescale resc
   if (a->GetNumberOfTuples() != out.VoxelCount())
     throw InputError(path + ": holds " + std::to_string(a->GetNumberOfTuples()) + " voxels, expected " +
       std::to_string(out.VoxelCount()) + " (truncated or corrupt?)");
-  StoreVoxels(a->GetVoidPointer(0), SourceTypeOfVtk(a->GetDataType(), path), out.VoxelCount(), rescale, out);
+  StoreArrayVoxels(a, out.VoxelCount(), rescale, ArrayHolder::Loader, out, path);
 }
 
 // VTK images may start at a non-zero extent; fold that into the origin.

@@ -1,17 +1,20 @@
 #include "vtkMultiMaterialVolumeReader.h"
 
 #include <cmath>
-#include <cstring>
 #include <exception>
 
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkDataObject.h>
 #include <vtkImageData.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkMatrix3x3.h>
+#include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
+#include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 
 #include "mmrtmVolumeLoader.h"
@@ -25,6 +28,7 @@ struct vtkMultiMaterialVolumeReader::Loaded
   std::string FileName, Series;
   vtkMTimeType Time = 0;
   bool Ok = false;
+  bool VoxelsGiven = false; // to the last output's scalars: a later RequestData loads them again
   double Origin[3], Spacing[3], Direction[9];
 };
 
@@ -121,18 +125,32 @@ int vtkMultiMaterialVolumeReader::RequestInformation(
 int vtkMultiMaterialVolumeReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
+  Loaded& v = *this->Volume;
+  if (v.VoxelsGiven)
+    v.Time = 0; // loaded again below
   if (!this->Load())
     return 0;
-  const Loaded& v = *this->Volume;
   vtkImageData* output = vtkImageData::GetData(outputVector);
   output->SetDimensions(v.Volume.dims[0], v.Volume.dims[1], v.Volume.dims[2]);
   output->SetSpacing(v.Spacing);
   output->SetOrigin(v.Origin);
   output->SetDirectionMatrix(v.Direction);
-  output->AllocateScalars(VtkType(v.Volume.type), 1);
-  vtkDataArray* scalars = output->GetPointData()->GetScalars();
+  // The output's scalars are the loaded voxels themselves, not a copy: the
+  // array reads them in place (VTK never frees them) and an observer it
+  // owns frees them when the array goes.
+  auto* voxels = new mmrtm::VoxelBuffer(std::move(v.Volume.voxels));
+  v.Volume.voxels = mmrtm::VoxelBuffer();
+  v.VoxelsGiven = true;
+  vtkNew<vtkCallbackCommand> owner;
+  owner->SetClientData(voxels);
+  owner->SetClientDataDeleteCallback([](void* buffer) { delete static_cast<mmrtm::VoxelBuffer*>(buffer); });
+  auto scalars = vtkSmartPointer<vtkDataArray>::Take(vtkDataArray::CreateDataArray(VtkType(v.Volume.type)));
+  scalars->AddObserver(vtkCommand::DeleteEvent, owner);
+  scalars->SetNumberOfComponents(1);
+  scalars->SetVoidArray(const_cast<uint8_t*>(voxels->data()),
+    static_cast<vtkIdType>(voxels->size() / mmrtm::VoxelTypeSize(v.Volume.type)), /*save=*/1);
   scalars->SetName("scalars");
-  std::memcpy(scalars->GetVoidPointer(0), v.Volume.voxels.data(), v.Volume.voxels.size());
+  output->GetPointData()->SetScalars(scalars);
   return 1;
 }
 

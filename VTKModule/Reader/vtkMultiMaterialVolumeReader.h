@@ -10,8 +10,10 @@
  * without ITK read uncompressed DICOM only, see CanReadCompressedDICOM). The output
  * vtkImageData carries the world geometry (LPS millimetres) as origin,
  * spacing and direction matrix, so vtkMultiMaterialVolumeMapper places it
- * as the file says. Errors (a missing file, a damaged series) are reported
- * with the file named, and the output is then empty.
+ * as the file says. The output's scalars are the loaded voxels themselves
+ * (held once: a later execution reads the file again). Errors (a missing
+ * file, a damaged series) are reported with the file named, and the output
+ * is then empty.
  */
 #ifndef vtkMultiMaterialVolumeReader_h
 #define vtkMultiMaterialVolumeReader_h

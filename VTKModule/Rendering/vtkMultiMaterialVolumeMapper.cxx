@@ -17,6 +17,7 @@
 #include <vtkCamera.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
+#include <vtkDemandDrivenPipeline.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
 #include <vtkColorTransferFunction.h>
@@ -473,6 +474,19 @@ void vtkMultiMaterialVolumeMapper::FinishPass(bool cancel)
   in.InFlight.reset();
 }
 
+// Whether bringing the input up to date will run its producer (the test
+// vtkDemandDrivenPipeline makes: data older than the pipeline's MTime).
+bool vtkMultiMaterialVolumeMapper::InputWillExecute()
+{
+  vtkAlgorithm* producer = this->GetInputAlgorithm();
+  vtkDataObject* data = this->GetInputDataObject(0, 0);
+  auto* executive = producer ? vtkDemandDrivenPipeline::SafeDownCast(producer->GetExecutive()) : nullptr;
+  if (!executive || !data)
+    return true;
+  executive->UpdatePipelineMTime();
+  return data->GetUpdateTime() < executive->GetPipelineMTime();
+}
+
 const mmrtm::Film* vtkMultiMaterialVolumeMapper::ImageFilm()
 {
   Internals& in = *this->Internal;
@@ -855,6 +869,10 @@ void vtkMultiMaterialVolumeMapper::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
     return;
   try
   {
+    // A pass in flight reads the input's voxels in place: it stops before
+    // the pipeline runs again, which may rewrite or reallocate them.
+    if (in.InFlight && this->InputWillExecute())
+      this->FinishPass(true);
     InputState now = this->ReadInputs(ren, vol, viewport);
     const Changes changes = this->ChangesSince(in.Built, now);
 

@@ -585,6 +585,7 @@ private:
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();
   void FinishPass(bool cancel);
+  bool InputWillExecute();
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
   vtkMTimeType TracingMTime();

@@ -34,7 +34,7 @@ std::vector<float> ToFloat(const HostVolume& v) {
 template <typename T>
 void Store(HostVolume& out, const std::vector<float>& values) {
   out.voxels.resize(values.size() * sizeof(T));
-  T* p = reinterpret_cast<T*>(out.voxels.data());
+  T* p = reinterpret_cast<T*>(out.voxels.MutableData());
   ParallelFor((int64_t)values.size(), 0, [&](int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) p[i] = (T)values[i];
   });
@@ -172,11 +172,12 @@ HostVolume OpacityProxy(const HostVolume& source, const std::vector<std::array<f
   HostVolume out = EmptyLike(source, name, "opacity");
   out.type = VoxelType::UInt8;
   out.voxels.resize((size_t)source.VoxelCount());
+  uint8_t* opacity = out.voxels.MutableData();
   ParallelFor(source.VoxelCount(), 0, [&](int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) {
       float o;
       tf.Evaluate(source.Value(i), &o);
-      out.voxels[i] = (uint8_t)std::lround(o * 255.f);
+      opacity[i] = (uint8_t)std::lround(o * 255.f);
     }
   });
   return out;

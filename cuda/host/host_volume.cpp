@@ -98,17 +98,18 @@ Vec3 HostVolume::WorldCenter() const {
 
 void HostVolume::ReplaceNanVoxels() {
   if (type != VoxelType::Float32) return;
-  float* f = reinterpret_cast<float*>(voxels.data());
   const int64_t n = std::min<int64_t>(VoxelCount(), (int64_t)(voxels.size() / sizeof(float)));
+  const float* in = reinterpret_cast<const float*>(voxels.data());
   float least = std::numeric_limits<float>::infinity();
   int64_t nans = 0;
   for (int64_t i = 0; i < n; ++i)
-    if (std::isnan(f[i]))
+    if (std::isnan(in[i]))
       ++nans;
-    else if (std::isfinite(f[i]))
-      least = std::min(least, f[i]);
+    else if (std::isfinite(in[i]))
+      least = std::min(least, in[i]);
   if (nans == 0) return;
   if (!std::isfinite(least)) least = 0.f;
+  float* f = reinterpret_cast<float*>(voxels.MutableData());
   for (int64_t i = 0; i < n; ++i)
     if (std::isnan(f[i])) f[i] = least;
   nanVoxelsReplaced += nans;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mmrtm/volume.h"
+#include "voxel_buffer.h"
 
 namespace mmrtm {
 
@@ -25,8 +26,8 @@ struct HostVolume {
   VoxelType type = VoxelType::UInt8;
   Interpolation interpolation = Interpolation::Trilinear;
   std::array<int, 3> dims{0, 0, 0};
-  std::vector<uint8_t> voxels;  // dims[0]*dims[1]*dims[2] values of `type`, x fastest
-  Affine3 indexToWorld;         // voxel index -> world (millimetres, LPS for medical data)
+  VoxelBuffer voxels;    // dims[0]*dims[1]*dims[2] values of `type`, x fastest; owned or borrowed
+  Affine3 indexToWorld;  // voxel index -> world (millimetres, LPS for medical data)
 
   // How messages name the volume: its source, else its proxy name.
   const std::string& Where() const { return source.empty() ? name : source; }
@@ -47,6 +48,8 @@ struct HostVolume {
   // function that is 0 there (air, background), and interpolation next to
   // them stays finite. Adds their number to nanVoxelsReplaced, for the
   // caller to warn about. Infinite voxels are left (Validate rejects them).
+  // Borrowed voxels are copied first, and only when they hold a NaN (the
+  // caller's array is never written).
   void ReplaceNanVoxels();
   int64_t nanVoxelsReplaced = 0;
 };

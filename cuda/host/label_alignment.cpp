@@ -69,6 +69,7 @@ HostVolume AlignLabelsToVolume(HostVolume labels, const HostVolume& reference, b
   out.indexToWorld = reference.indexToWorld;
   const int bytes = VoxelTypeSize(labels.type);
   out.voxels.assign((size_t)out.VoxelCount() * bytes, 0);  // 0 bytes are label 0 for every type
+  uint8_t* aligned = out.voxels.MutableData();
 
   // Evaluated in double: a float evaluation could put centres that fall
   // exactly on a label voxel boundary on either side, row by row.
@@ -90,7 +91,7 @@ HostVolume AlignLabelsToVolume(HostVolume labels, const HostVolume& reference, b
           if (!inside) continue;
           const int64_t src = idx[0] + lnx * (idx[1] + lny * idx[2]);
           const int64_t dst = i + (int64_t)nx * (j + (int64_t)ny * k);
-          std::memcpy(&out.voxels[dst * bytes], &labels.voxels[src * bytes], bytes);
+          std::memcpy(&aligned[dst * bytes], &labels.voxels[src * bytes], bytes);
         }
   });
 
