@@ -108,10 +108,6 @@ ViewerScene::ViewerScene() {
   vtkNew<vtkVolumeProperty> property;  // the description replaces its functions
   volume_->SetProperty(property);
   mapper_->SetMultiMaterialProperty(materials_);
-  // The viewer shows the tracer's own scenes (presets, saved descriptions),
-  // made for the filmic curve that mmrtm-render applies too, not VTK's
-  // colour conventions.
-  mapper_->SetToneMappingToFilmic();
   // Refinement passes run beside the event loop (the window stays responsive).
   mapper_->AsynchronousRefinementOn();
   mapper_->SetSamplesPerRender(settings_.samplesPerRender);

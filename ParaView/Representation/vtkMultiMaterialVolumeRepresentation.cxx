@@ -32,6 +32,11 @@ vtkMultiMaterialVolumeRepresentation::vtkMultiMaterialVolumeRepresentation()
   // gives 64 samples a pixel; a render of the unchanged view only redraws.
   this->SetSamplesPerRender(64);
   this->SetMaximumSamples(64);
+  // A representation chosen for its path tracing: ParaView's volumes are
+  // unshaded by default, and as VTK draws them (the mapper's VTK look) they
+  // would glow unlit; here they scatter the lights, with shadows, under the
+  // filmic curve.
+  this->Mapper()->SetLookToFilmic();
 }
 
 vtkMultiMaterialVolumeRepresentation::~vtkMultiMaterialVolumeRepresentation()

@@ -216,6 +216,39 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.counts(), (1, 1, 2), "one restart per view")
         self.assertGreater(coverage(s.pixels()), 0.05)
 
+    def test_automatic_tone_mapping_is_off_for_a_property_and_the_description_s_for_a_preset(self):
+        """The default tone mapping draws a vtkVolumeProperty's scene as VTK
+        writes colours (no curve: the same pixels as OFF) and a preset's
+        description with its own curve (filmic: the same pixels as FILMIC),
+        without restarting the accumulation. Catches a preset drawn without
+        the curve it is made for (the C++ example's skull went dark) and a
+        property drawn through it (VTK's colours lost)."""
+        def drawn(s, mode):
+            s.mapper.SetToneMapping(mode)
+            s.render()  # converged: a redraw
+            return s.pixels()
+
+        def converged(s):
+            for _ in range(4):
+                s.render()
+            self.assertTrue(s.mapper.IsConverged())
+
+        s = Scene()
+        converged(s)
+        auto = drawn(s, vtkMultiMaterialVolumeMapper.AUTOMATIC_TONE_MAPPING)
+        self.assertEqual(auto, drawn(s, vtkMultiMaterialVolumeMapper.TONE_MAPPING_OFF))
+        self.assertGreater(mean_abs_difference(auto, drawn(s, vtkMultiMaterialVolumeMapper.FILMIC_TONE_MAPPING)), 0.01)
+        materials = vtkMultiMaterialProperty()
+        self.assertTrue(materials.SetPreset("ct-bone"))
+        p = Scene()
+        p.mapper.SetMultiMaterialProperty(materials)
+        converged(p)
+        auto = drawn(p, vtkMultiMaterialVolumeMapper.AUTOMATIC_TONE_MAPPING)
+        restarts = p.mapper.GetNumberOfRestarts()
+        self.assertEqual(auto, drawn(p, vtkMultiMaterialVolumeMapper.FILMIC_TONE_MAPPING))
+        self.assertGreater(mean_abs_difference(auto, drawn(p, vtkMultiMaterialVolumeMapper.TONE_MAPPING_OFF)), 0.01)
+        self.assertEqual(p.mapper.GetNumberOfRestarts(), restarts, "a tone mapping change redraws, no restart")
+
     def test_a_projection_blend_mode_is_one_sample(self):
         """Maximum intensity is a projection: one sample per pixel through
         the pixel's centre is the whole image, so the mapper traces one and

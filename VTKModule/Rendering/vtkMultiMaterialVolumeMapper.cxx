@@ -514,14 +514,14 @@ void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
 
 void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
 {
-  mode = std::clamp(mode, static_cast<int>(TONE_MAPPING_OFF), static_cast<int>(FILMIC_TONE_MAPPING));
+  mode = std::clamp(mode, static_cast<int>(AUTOMATIC_TONE_MAPPING), static_cast<int>(FILMIC_TONE_MAPPING));
   if (mode != this->ToneMapping)
     this->DisplayEdit([&] { this->ToneMapping = mode; });
 }
 
 void vtkMultiMaterialVolumeMapper::SetLookToVTK()
 {
-  this->SetToneMappingToOff();
+  this->SetToneMappingToAutomatic();
   this->SetUnshadedScattering(0);
 }
 
@@ -1615,10 +1615,12 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
   const int width = film.Width(), height = film.Height();
   // A projection's film holds VTK's colours made linear: no curve.
   const mmrtm::RenderSettings& rs = this->Internal->Scene.render;
+  const bool description = this->Internal->MultiMaterial != nullptr;
   const mmrtm::ToneMapper toneMapper = rs.integrator.projection.mode != mmrtm::IntensityProjection::None
     ? mmrtm::ToneMapper::Clamp
-    : this->ToneMapping == FILMIC_TONE_MAPPING ? mmrtm::ToneMapper::Filmic
-                                               : mmrtm::ToneMapper::Off;
+    : this->ToneMapping == FILMIC_TONE_MAPPING                   ? mmrtm::ToneMapper::Filmic
+    : this->ToneMapping == AUTOMATIC_TONE_MAPPING && description ? rs.toneMapper // the description's
+                                                                 : mmrtm::ToneMapper::Off;
   std::vector<uint8_t> rgba = film.ToneMapped(static_cast<float>(this->Exposure), toneMapper, 4);
   const size_t row = 4 * static_cast<size_t>(width);
   for (int y = 0; y < height / 2; ++y)

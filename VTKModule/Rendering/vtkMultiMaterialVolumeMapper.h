@@ -216,22 +216,27 @@ public:
 
   ///@{
   /**
-   * How the accumulated radiance becomes pixel values. TONE_MAPPING_OFF
-   * (the default): the value itself, clipped at 1, as VTK's mappers write
-   * their colours (the colour functions hold display values, so a white
-   * surface facing VTK's headlight shows its colour times Diffuse). FILMIC:
-   * the ACES filmic curve and the sRGB encoding, soft highlights for scenes
-   * lit beyond 1 (environment maps, several lights, emission). Like the
-   * exposure, a change redraws the samples accumulated so far. The
-   * projection blend modes show VTK's colours either way.
+   * How the accumulated radiance becomes pixel values. OFF: the value
+   * itself, clipped at 1, as VTK's mappers write their colours (the colour
+   * functions hold display values, so a white surface facing VTK's
+   * headlight shows its colour times Diffuse). FILMIC: the ACES filmic
+   * curve and the sRGB encoding, soft highlights for scenes lit beyond 1
+   * (environment maps, several lights, emission). AUTOMATIC (the default):
+   * off for a translated vtkVolumeProperty; with a vtkMultiMaterialProperty
+   * its description's "tone_mapper" (filmic unless it says otherwise, as in
+   * mmrtm-render: the presets are made for it). Like the exposure, a change
+   * redraws the samples accumulated so far. The projection blend modes show
+   * VTK's colours either way.
    */
   enum ToneMappings
   {
-    TONE_MAPPING_OFF = 0,
-    FILMIC_TONE_MAPPING = 1
+    AUTOMATIC_TONE_MAPPING = 0,
+    TONE_MAPPING_OFF = 1,
+    FILMIC_TONE_MAPPING = 2
   };
   virtual void SetToneMapping(int mode);
   vtkGetMacro(ToneMapping, int);
+  void SetToneMappingToAutomatic() { this->SetToneMapping(AUTOMATIC_TONE_MAPPING); }
   void SetToneMappingToOff() { this->SetToneMapping(TONE_MAPPING_OFF); }
   void SetToneMappingToFilmic() { this->SetToneMapping(FILMIC_TONE_MAPPING); }
   ///@}
@@ -266,10 +271,10 @@ public:
 
   ///@{
   /**
-   * Looks: SetLookToVTK (the default) gives VTK's colours: tone mapping
-   * off, unshaded volumes glow. SetLookToFilmic is the path tracer's own:
-   * filmic tone mapping, unshaded volumes scatter the lights. Neither
-   * changes GlobalIllumination.
+   * Looks: SetLookToVTK (the default) gives VTK's colours: automatic
+   * tone mapping (off for a vtkVolumeProperty), unshaded volumes glow.
+   * SetLookToFilmic is the path tracer's own: filmic tone mapping, unshaded
+   * volumes scatter the lights. Neither changes GlobalIllumination.
    */
   void SetLookToVTK();
   void SetLookToFilmic();
@@ -533,7 +538,7 @@ protected:
   int NumberOfThreads = 0;
   int Backend = AUTO;
   double Exposure = 1.0;
-  int ToneMapping = TONE_MAPPING_OFF;
+  int ToneMapping = AUTOMATIC_TONE_MAPPING;
   vtkTypeBool UnshadedScattering = 0;
   vtkTypeBool GlobalIllumination = 1;
   double NoiseTarget = 0.0;
