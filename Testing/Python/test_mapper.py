@@ -490,9 +490,10 @@ class MapperTest(unittest.TestCase):
         s.render()
         s.mapper.GetLastFilmSize(size)
         self.assertEqual(size, [43, 43], "a distance that does not divide the viewport rounds up")
-        # Previews at a budget no frame can meet: fixed with AutoAdjust off,
-        # coarser with it on.
-        s.window.SetDesiredUpdateRate(1000.0)
+        # Previews at a budget no frame can meet (1 us: a 16 x 16 frame
+        # takes a fraction of a millisecond, so 1 ms was met on a fast or
+        # idle machine): fixed with AutoAdjust off, coarser with it on.
+        s.window.SetDesiredUpdateRate(1.0e6)
         sizes = set()
         for _ in range(4):
             s.renderer.GetActiveCamera().Azimuth(5)
