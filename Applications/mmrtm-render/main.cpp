@@ -279,22 +279,34 @@ void CheckWritable(const std::string& path) {
   if (fs::is_directory(path)) throw mmrtm::InputError(path + ": is a folder");
 }
 
+// Loading and building bars appear only for steps longer than this.
+constexpr double kQuietStepSeconds = 0.5;
+
 // A bar redrawn in place on a terminal; on a log (not a terminal) one line
 // every 10 %.
 class ProgressBar {
  public:
-  explicit ProgressBar(bool enabled)
-      : enabled_(enabled), terminal_(isatty(fileno(stderr))), start_(std::chrono::steady_clock::now()) {}
+  // A bar with a `delay` shows only once that many seconds have passed, so
+  // that a step that takes a moment (a small volume's loading) says nothing.
+  explicit ProgressBar(bool enabled, std::string what = "Rendering", double delay = 0.0)
+      : enabled_(enabled),
+        terminal_(isatty(fileno(stderr))),
+        what_(std::move(what)),
+        delay_(delay),
+        start_(std::chrono::steady_clock::now()) {}
+  // A fraction of 1 (loading, building).
+  void operator()(double fraction) { (*this)((int)(1000 * std::clamp(fraction, 0.0, 1.0)), 1000); }
   void operator()(int done, int total) {
     if (!enabled_) return;
     const double elapsed = Seconds();
+    if ((elapsed < delay_ && lastPercent_ < 0) || lastPercent_ == 100) return;  // not yet shown, or finished
     const int percent = (int)(100.0 * done / total);
     const int step = terminal_ ? 1 : 10;
     if (percent / step == lastPercent_ / step && done != total) return;
     lastPercent_ = percent;
     const int width = 30, filled = width * done / total;
     const double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
-    std::fprintf(stderr, "%sRendering [%s%s] %3d%%  %.1f s, %.0f s left%s", terminal_ ? "\r" : "",
+    std::fprintf(stderr, "%s%s [%s%s] %3d%%  %.1f s, %.0f s left%s", terminal_ ? "\r" : "", what_.c_str(),
                  std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), percent, elapsed, eta,
                  terminal_ && done != total ? " " : "\n");
     std::fflush(stderr);
@@ -303,6 +315,8 @@ class ProgressBar {
 
  private:
   bool enabled_, terminal_;
+  std::string what_;
+  double delay_;
   std::chrono::steady_clock::time_point start_;
   int lastPercent_ = -1;
 };
@@ -467,6 +481,8 @@ int Run(const Options& o) {
     if (!o.quiet) std::fprintf(stderr, "Loading %s\n", input.c_str());
     mmrtm::VolumeLoadOptions load;
     load.series = o.series;
+    ProgressBar loading(!o.quiet, "Loading", kQuietStepSeconds);
+    load.progress = [&](double fraction) { loading(fraction); };
     inputs.volumes["scalars"] = WarnAboutNanVoxels(mmrtm::LoadVolume(input, "scalars", load));
   } else if (!o.series.empty()) {
     throw mmrtm::InputError("--series needs a DICOM folder as INPUT");
@@ -489,6 +505,8 @@ int Run(const Options& o) {
 
   const auto tBuild = std::chrono::steady_clock::now();
   mmrtm::Scene scene = mmrtm::SceneFromJson(doc, std::move(inputs));
+  ProgressBar building(!o.quiet, "Building the majorant grid", kQuietStepSeconds);
+  scene.buildProgress = [&](double fraction) { building(fraction); };
   mmrtm::SceneView view = scene.Build();
   if (!scene.ExtinctionWarning().empty()) std::fprintf(stderr, "warning: %s\n", scene.ExtinctionWarning().c_str());
   const double buildSeconds = SecondsSince(tBuild);

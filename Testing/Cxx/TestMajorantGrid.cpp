@@ -501,6 +501,35 @@ TEST(LeafSummaries, LeavesShareTheirSummaries) {
   EXPECT_LT(grid.SummaryBytes(), (size_t)grid.LeafCount() * 8) << "4 B of id per leaf, and the table";
 }
 
+// The summary build shares the layers of leaves among its threads as they
+// come free: the ids, summaries and majorants must not depend on the
+// thread count (catches a layer written by two threads, or ids taken in
+// the order the threads finish), and the build reports its progress up to 1.
+TEST(LeafSummaries, TheBuildIsTheSameOnAnyThreadCountAndReportsItsProgress) {
+  const HostVolume ct = LoadVolume(Data("ct_head_cranium.nrrd"));
+  Scene one = SceneWith({ct}, {CCTF({500.f, 1500.f}, {0.f, 1.f})}, 1.f, MajorantKind::Octree);
+  one.render.accelerator.grid.threads = 1;
+  one.Build();
+  Scene three = SceneWith({ct}, {CCTF({500.f, 1500.f}, {0.f, 1.f})}, 1.f, MajorantKind::Octree);
+  three.render.accelerator.grid.threads = 3;
+  std::vector<double> fractions;
+  three.buildProgress = [&](double f) { fractions.push_back(f); };
+  three.Build();
+  EXPECT_EQ(one.Grid()->LeafSummaryIds(), three.Grid()->LeafSummaryIds());
+  for (int64_t leaf = 0; leaf < one.Grid()->LeafCount(); ++leaf)
+    ASSERT_EQ(LeafWords(*one.Grid(), 0, leaf), LeafWords(*three.Grid(), 0, leaf)) << "leaf " << leaf;
+  for (int64_t i = 0; i < one.Grid()->NodeCount(); ++i)
+    ASSERT_EQ(one.Grid()->View().majorants[i], three.Grid()->View().majorants[i]) << "node " << i;
+  ASSERT_GT(fractions.size(), 2u);
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+  EXPECT_EQ(fractions.back(), 1.0);
+  // A refit reads no voxels: it reports nothing.
+  fractions.clear();
+  three.tfs[0] = CCTF({600.f, 1500.f}, {0.f, 1.f});
+  three.Build();
+  EXPECT_TRUE(fractions.empty());
+}
+
 // Writes `value` into the voxels [lo, hi] of the scene's 64 x 64 x N int16
 // proxy 0 (ct_head_headsq), as an editing tool does before it marks the region.
 void PaintBlock(Scene& scene, const std::array<int, 3>& lo, const std::array<int, 3>& hi, int16_t value) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -478,6 +479,100 @@ TEST(VolumeLoader, NanVoxelIsTheLeastValueAndInfinityIsRejected) {
   values[7] = std::numeric_limits<float>::infinity();
   WriteFloatNrrd(path, "dimension: 3\nsizes: 3 2 2\nspacings: 1 1 1\n", values);
   ExpectInputError(path, "non-finite");
+}
+
+// A NRRD of the values 0, 1, 2, ... (mod the type's span, signed types
+// negative in part) as `encoding` (raw or gzip) in `endian` byte order, its
+// data attached or in a detached file. Returns the header's path.
+std::string WriteNrrdOfType(const std::string& name, const std::string& type, int size, const std::string& encoding,
+                            const std::string& endian, bool detached) {
+  const std::string path = Scratch(name + (detached ? ".nhdr" : ".nrrd"));
+  const int nx = 37, ny = 11, nz = 5;
+  std::vector<uint8_t> bytes((size_t)nx * ny * nz * size);
+  for (int i = 0; i < nx * ny * nz; ++i) {
+    uint8_t* v = bytes.data() + (size_t)i * size;
+    if (type == "float") {
+      const float f = 0.25f * (float)i - 100.f;
+      std::memcpy(v, &f, 4);
+    } else {
+      const int value = type == "short" ? i - 1000 : i;
+      std::memcpy(v, &value, (size_t)size);  // little endian, as this machine is
+    }
+    if (endian == "big") std::reverse(v, v + size);
+  }
+  const std::string dataName = name + (encoding == "gzip" ? ".raw.gz" : ".raw");
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "NRRD0004\ntype: " << type << "\ndimension: 3\nsizes: " << nx << " " << ny << " " << nz
+        << "\nspacings: 1 1 1\nencoding: " << encoding << "\nendian: " << endian << "\n";
+    if (detached) out << "data file: " << dataName << "\n";
+    out << "\n";
+  }
+  const std::string dataPath = detached ? (fs::path(path).parent_path() / dataName).string() : path;
+  if (detached) fs::remove(dataPath);
+  if (encoding == "gzip") {
+    gzFile gz = gzopen(dataPath.c_str(), "ab");
+    gzwrite(gz, bytes.data(), (unsigned)bytes.size());
+    gzclose(gz);
+  } else {
+    std::ofstream(dataPath, std::ios::binary | std::ios::app)
+        .write(reinterpret_cast<const char*>(bytes.data()), (std::streamsize)bytes.size());
+  }
+  return path;
+}
+
+// Raw NRRD data of a native type is read straight into the volume; every
+// other encoding still goes through vtkNrrdReader. Both must give the same
+// voxels in the same type: catches a wrong data offset (attached or
+// detached), bytes not swapped from big endian, and a row order that
+// differs from vtkNrrdReader's (which reverses rows and has them put back).
+TEST(VolumeLoader, RawNrrdReadDirectlyEqualsTheVtkReadersVoxels) {
+  struct Type {
+    const char* name;
+    int size;
+    VoxelType voxelType;
+  };
+  for (const Type& t : {Type{"uchar", 1, VoxelType::UInt8}, Type{"short", 2, VoxelType::Int16},
+                        Type{"ushort", 2, VoxelType::UInt16}, Type{"float", 4, VoxelType::Float32}}) {
+    SCOPED_TRACE(t.name);
+    const HostVolume reference = LoadVolume(WriteNrrdOfType("gz", t.name, t.size, "gzip", "little", false));
+    ASSERT_EQ(reference.type, t.voxelType);
+    for (const char* endian : {"little", "big"})
+      for (bool detached : {false, true}) {
+        SCOPED_TRACE(std::string(endian) + (detached ? " detached" : " attached"));
+        const HostVolume v = LoadVolume(WriteNrrdOfType("raw", t.name, t.size, "raw", endian, detached));
+        EXPECT_EQ(v.type, t.voxelType);
+        EXPECT_EQ(v.dims, reference.dims);
+        EXPECT_TRUE(v.voxels == reference.voxels);
+      }
+  }
+}
+
+// A raw data file shorter than its header's sizes, and a gzip stream cut
+// short: errors that name the file, no volume.
+TEST(VolumeLoader, ShortRawDataFileAndTruncatedGzipStreamAreErrors) {
+  const std::string detached = WriteNrrdOfType("short_detached", "short", 2, "raw", "little", true);
+  const std::string data = (fs::path(detached).parent_path() / "short_detached.raw").string();
+  fs::resize_file(data, fs::file_size(data) - 2);
+  ExpectInputError(detached, "short_detached.raw");
+  const std::string gz = WriteNrrdOfType("cut_gzip", "short", 2, "gzip", "little", false);
+  fs::resize_file(gz, fs::file_size(gz) - 40);
+  ExpectInputError(gz);
+}
+
+// Loading reports its progress: fractions that never go back and end at 1,
+// for the direct raw read and for a VTK reader's (gzip) read.
+TEST(VolumeLoader, LoadingReportsProgressUpToOne) {
+  for (const char* encoding : {"raw", "gzip"}) {
+    SCOPED_TRACE(encoding);
+    std::vector<double> fractions;
+    mmrtm::VolumeLoadOptions options;
+    options.progress = [&](double f) { fractions.push_back(f); };
+    LoadVolume(WriteNrrdOfType("progress", "short", 2, encoding, "little", false), "scalars", options);
+    ASSERT_FALSE(fractions.empty());
+    EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+    EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
+  }
 }
 
 TEST(VolumeLoader, DefaultVolumePath) {

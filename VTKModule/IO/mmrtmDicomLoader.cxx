@@ -266,7 +266,7 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoa
     slices.push_back(ReadDicomSliceHeader(reader->SliceFile(i)));
   CheckDicomSlicesMatch(folder, slices);
 
-  vtkImageData* image = RunReader(reader, folder);
+  vtkImageData* image = RunReader(reader, folder, options.progress);
   StoreImageVoxels(image, folder, Rescale{}, out); // the reader has rescaled already
   if (out.dims[2] != n || out.dims[0] != slices[0].width || out.dims[1] != slices[0].height)
     throw InputError(folder + ": the DICOM reader returned an unexpected volume size");

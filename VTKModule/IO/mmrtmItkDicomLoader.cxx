@@ -319,29 +319,63 @@ void ReadSlicePixels(const std::string& folder, const SliceHeader& s, float* dst
   std::copy(image->GetBufferPointer(), image->GetBufferPointer() + (size_t)s.rows * s.columns, dst);
 }
 
-// Linear interpolation of the slices (at offsets d) onto `count` slices
-// `spacing` apart. Integer input stays integer (rounded), so CT keeps int16.
-std::vector<float> ResampleSlices(const std::vector<float>& voxels, int64_t sliceVoxels, const std::vector<double>& d,
-  int count, double spacing, bool integers)
+// The slices decoded one at a time into a SliceStack: as they are when they
+// are evenly spaced; else resampled onto `count` slices `spacing` apart by
+// linear interpolation between the two slices (at offsets d) around each,
+// so that only those two are held as floats. Integer slices stay integer
+// (rounded), so CT keeps int16.
+void StackSlices(const std::string& folder, const std::vector<SliceHeader>& slices, const std::vector<double>& d,
+  int count, double spacing, bool uneven, int64_t sliceVoxels, SliceStack& stack, const VolumeLoadOptions& options)
 {
-  std::vector<float> out((size_t)(sliceVoxels * count));
+  struct Decoded
+  {
+    int index = -1;
+    std::vector<float> values;
+    ValueStats stats;
+  };
+  Decoded held[2];
+  // Slice k, decoded unless one of the two held slices is k (`keep` is not
+  // overwritten).
+  auto decode = [&](int k, const Decoded* keep) -> const Decoded&
+  {
+    for (const Decoded& h : held)
+      if (h.index == k)
+        return h;
+    Decoded& slot = &held[0] == keep ? held[1] : held[0];
+    slot.values.resize((size_t)sliceVoxels);
+    ReadSlicePixels(folder, slices[k], slot.values.data());
+    slot.stats = ScanFloatValues(slot.values.data(), sliceVoxels);
+    slot.index = k;
+    return slot;
+  };
+  std::vector<float> resampled(uneven ? (size_t)sliceVoxels : 0);
   size_t k = 0;
   for (int j = 0; j < count; ++j)
   {
-    const double t = std::min(j * spacing, d.back());
-    while (k + 2 < d.size() && d[k + 1] < t)
-      ++k;
-    const float w = (float)std::clamp((t - d[k]) / (d[k + 1] - d[k]), 0.0, 1.0);
-    const float* a = voxels.data() + k * sliceVoxels;
-    const float* b = a + sliceVoxels;
-    float* o = out.data() + j * sliceVoxels;
-    for (int64_t i = 0; i < sliceVoxels; ++i)
+    if (!uneven)
     {
-      const float v = a[i] + w * (b[i] - a[i]);
-      o[i] = integers ? std::nearbyint(v) : v;
+      const Decoded& slice = decode(j, nullptr);
+      stack.Put(j, slice.values.data(), slice.stats);
     }
+    else
+    {
+      const double t = std::min(j * spacing, d.back());
+      while (k + 2 < d.size() && d[k + 1] < t)
+        ++k;
+      const float w = (float)std::clamp((t - d[k]) / (d[k + 1] - d[k]), 0.0, 1.0);
+      const Decoded& a = decode((int)k, nullptr);
+      const Decoded& b = decode((int)k + 1, &a);
+      const bool integers = a.stats.allIntegers && b.stats.allIntegers;
+      for (int64_t i = 0; i < sliceVoxels; ++i)
+      {
+        const float v = a.values[i] + w * (b.values[i] - a.values[i]);
+        resampled[i] = integers ? std::nearbyint(v) : v;
+      }
+      stack.Put(j, resampled.data(), ScanFloatValues(resampled.data(), sliceVoxels));
+    }
+    if (options.progress)
+      options.progress((j + 1.0) / count);
   }
-  return out;
 }
 
 } // namespace
@@ -451,21 +485,14 @@ void LoadDicomFolder(const std::string& folder, HostVolume& out, const VolumeLoa
     }
   }
 
-  // Pixels: checked against the memory first (a float per voxel while
-  // reading, then the stored type).
-  CheckMemoryAvailable(folder,
-    4.0 * sliceVoxels * ((double)n + (uneven ? outSlices : 0)) + 2.0 * sliceVoxels * outSlices,
+  // Pixels: checked against the memory first (float voxels at the most),
+  // then decoded into the smallest exact type slice by slice.
+  CheckMemoryAvailable(folder, 4.0 * sliceVoxels * outSlices,
     std::to_string(first.columns) + " x " + std::to_string(first.rows) + " x " + std::to_string(outSlices) + " voxels");
-  std::vector<float> voxels((size_t)(sliceVoxels * n));
-  for (int i = 0; i < n; ++i)
-    ReadSlicePixels(folder, slices[i], voxels.data() + i * sliceVoxels);
-  if (uneven)
-  {
-    const bool integers = std::all_of(voxels.begin(), voxels.end(), [](float v) { return v == std::floor(v); });
-    voxels = ResampleSlices(voxels, sliceVoxels, d, outSlices, spacing, integers);
-  }
+  SliceStack stack(sliceVoxels, outSlices);
+  StackSlices(folder, slices, d, outSlices, spacing, uneven, sliceVoxels, stack, options);
   out.dims = { first.columns, first.rows, outSlices };
-  StoreVoxels(voxels.data(), SourceType::Float32, (int64_t)voxels.size(), Rescale{}, out, /*narrowFloats=*/true);
+  stack.MoveInto(out);
 
   // index -> world: columns are the row direction x column spacing, the
   // column direction x row spacing, and the slice step (possibly oblique).

@@ -112,12 +112,6 @@ void WithTypedPointer(SourceType type, const void* data, F&& f)
   }
 }
 
-struct ValueStats
-{
-  bool allIntegers = true;
-  double lo = std::numeric_limits<double>::infinity(), hi = -std::numeric_limits<double>::infinity();
-};
-
 template <typename T>
 ValueStats ScanValues(const T* p, int64_t n, Rescale r)
 {
@@ -133,8 +127,20 @@ ValueStats ScanValues(const T* p, int64_t n, Rescale r)
   return s;
 }
 
-// The smallest integer type that holds every value exactly, else float32.
-// int16 is preferred over uint16 when both fit: CT and most medical data are signed.
+} // namespace
+
+ValueStats ScanFloatValues(const float* values, int64_t count)
+{
+  return ScanValues(values, count, Rescale{});
+}
+
+void ValueStats::Add(const ValueStats& other)
+{
+  allIntegers = allIntegers && other.allIntegers;
+  lo = std::min(lo, other.lo);
+  hi = std::max(hi, other.hi);
+}
+
 VoxelType SmallestExactType(const ValueStats& s)
 {
   if (!s.allIntegers)
@@ -147,6 +153,9 @@ VoxelType SmallestExactType(const ValueStats& s)
     return VoxelType::UInt16;
   return VoxelType::Float32;
 }
+
+namespace
+{
 
 template <typename Out, typename In>
 void ConvertValues(const In* in, int64_t n, Rescale r, uint8_t* outBytes)
@@ -175,10 +184,9 @@ std::optional<VoxelType> NativeVoxelType(SourceType t)
   }
 }
 
-void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out, bool narrowFloats)
+void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out)
 {
-  if (const auto native = NativeVoxelType(type);
-      native && rescale.IsIdentity() && !(narrowFloats && type == SourceType::Float32))
+  if (const auto native = NativeVoxelType(type); native && rescale.IsIdentity())
   {
     out.type = *native;
     const auto* bytes = static_cast<const uint8_t*>(data);
@@ -188,7 +196,7 @@ void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale resca
   // float32 stays float32 after a rescale; every other type may become an
   // integer type when its (rescaled) values allow it.
   VoxelType target = VoxelType::Float32;
-  if (type != SourceType::Float32 || narrowFloats)
+  if (type != SourceType::Float32)
     WithTypedPointer(type, data, [&](auto* p) { target = SmallestExactType(ScanValues(p, count, rescale)); });
   out.type = target;
   out.voxels.resize((size_t)(count * VoxelTypeSize(target)));
@@ -323,17 +331,23 @@ void CheckFileNamePattern(const std::string& path, const std::string& what, cons
     throw InputError(path + ": " + what + ": a file-name pattern needs exactly one %d");
 }
 
-void CheckDeclaredVoxelBytes(
-  const std::string& path, double declaredBytes, double count, double fileBytes, DataEncoding encoding)
+void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
+  DataEncoding encoding, const std::string& dataFile)
 {
   constexpr double kMaxDeflateRatio = 1032.0; // zlib's limit for any input
   const double needed = encoding == DataEncoding::Raw ? declaredBytes
     : encoding == DataEncoding::Compressed            ? declaredBytes / kMaxDeflateRatio
                                                       : count;
   if (!(needed <= fileBytes))
-    throw InputError(path + ": the header promises " + HumanBytes(declaredBytes) + " of voxels but the file holds " +
-      HumanBytes(fileBytes) + (encoding == DataEncoding::Compressed ? " of compressed data" : "") +
+  {
+    // Exact counts where the rounded ones would read the same.
+    const bool close = HumanBytes(declaredBytes) == HumanBytes(fileBytes);
+    const auto bytes = [&](double b) { return close ? std::to_string((long long)b) + " bytes" : HumanBytes(b); };
+    throw InputError(path + ": the header promises " + bytes(declaredBytes) + " of voxels but " +
+      (dataFile.empty() ? "the file" : "its data file '" + dataFile + "'") + " holds " + bytes(fileBytes) +
+      (encoding == DataEncoding::Compressed ? " of compressed data" : "") +
       " (truncated, or a corrupt header); nothing was allocated");
+  }
   CheckMemoryAvailable(path, 2.0 * declaredBytes, "the voxels");
 }
 

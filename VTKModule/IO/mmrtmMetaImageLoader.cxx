@@ -362,7 +362,7 @@ void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOpt
   CheckMetaImageDeclaredSize(path, header);
   vtkNew<vtkMetaImageReader> reader;
   reader->SetFileName(path.c_str());
-  vtkImageData* image = RunReader(reader, path);
+  vtkImageData* image = RunReader(reader, path, options.progress);
   vtkDataArray* a = VoxelArray(image, path);
   CheckMetaImageData(path, header, static_cast<uint8_t*>(a->GetVoidPointer(0)),
     (uint64_t)a->GetNumberOfValues() * (uint64_t)a->GetDataTypeSize(), a->GetDataTypeSize(), options);

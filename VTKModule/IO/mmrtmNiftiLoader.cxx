@@ -167,12 +167,12 @@ void CheckNiftiHeader(const std::string& path)
 
 } // namespace
 
-void LoadNifti(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/)
+void LoadNifti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options)
 {
   CheckNiftiHeader(path);
   vtkNew<vtkNIFTIImageReader> reader;
   reader->SetFileName(path.c_str());
-  vtkImageData* image = RunReader(reader, path);
+  vtkImageData* image = RunReader(reader, path, options.progress);
   if (reader->GetTimeDimension() > 1)
     throw InputError(
       path + ": has " + std::to_string(reader->GetTimeDimension()) + " time points; a single 3D volume is needed");

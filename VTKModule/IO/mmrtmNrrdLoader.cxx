@@ -1,5 +1,7 @@
-// NRRD volumes (.nrrd, .nhdr): vtkNrrdReader reads the voxels; the geometry
-// and the axis layout come from this file's own parse of the NRRD header.
+// NRRD volumes (.nrrd, .nhdr): raw voxels of a native type are read straight
+// into the volume (ReadRawVoxels); vtkNrrdReader reads the others (gzip,
+// text, split data, converted types). The geometry and the axis layout come
+// from this file's own parse of the NRRD header.
 #include "mmrtmVolumeLoaderInternal.h"
 
 #include <algorithm>
@@ -43,9 +45,12 @@ struct NrrdHeader
   bool hasSpaceDirections = false;
   std::vector<std::optional<Vec3d>> directions; // per axis; nullopt = "none"
   std::optional<Vec3d> origin;
-  std::vector<double> spacings; // per axis, from the older `spacings` field
-  int typeSize = 0;             // bytes per value of `type`; 0 if unknown
-  std::string dataFile;         // `data file` as written; "" when the data is attached
+  std::vector<double> spacings;        // per axis, from the older `spacings` field
+  int typeSize = 0;                    // bytes per value of `type`; 0 if unknown
+  std::optional<VoxelType> nativeType; // `type` when the tracer samples it as it is
+  bool bigEndian = false;              // `endian: big`
+  bool skips = false;                  // a `line skip` or `byte skip` other than 0
+  std::string dataFile;                // `data file` as written; "" when the data is attached
   // How vtkNrrdReader reads `data file`: a first word "LIST" exactly is a
   // list of files; four words or more are a name pattern (so
   // "LISTslice%d.raw 1 2 0" is a pattern: a fuzz finding); fewer are one
@@ -76,6 +81,23 @@ int NrrdTypeSize(const std::string& type)
     if (type == name)
       return size;
   return 0;
+}
+
+// The voxel type of a NRRD `type` the tracer samples as it is; nullopt for
+// the others (converted by StoreVoxels).
+std::optional<VoxelType> NrrdNativeType(const std::string& type)
+{
+  static const std::pair<const char*, VoxelType> kTypes[] = { { "uchar", VoxelType::UInt8 },
+    { "unsigned char", VoxelType::UInt8 }, { "uint8", VoxelType::UInt8 }, { "uint8_t", VoxelType::UInt8 },
+    { "short", VoxelType::Int16 }, { "short int", VoxelType::Int16 }, { "signed short", VoxelType::Int16 },
+    { "signed short int", VoxelType::Int16 }, { "int16", VoxelType::Int16 }, { "int16_t", VoxelType::Int16 },
+    { "ushort", VoxelType::UInt16 }, { "unsigned short", VoxelType::UInt16 },
+    { "unsigned short int", VoxelType::UInt16 }, { "uint16", VoxelType::UInt16 }, { "uint16_t", VoxelType::UInt16 },
+    { "float", VoxelType::Float32 } };
+  for (const auto& [name, voxelType] : kTypes)
+    if (type == name)
+      return voxelType;
+  return std::nullopt;
 }
 
 // "(a,b,c)" -> vector; "none" -> nullopt. Throws on anything else.
@@ -224,6 +246,15 @@ NrrdHeader ParseNrrdHeader(const std::string& path)
     else if (field == "type")
     {
       h.typeSize = NrrdTypeSize(ToLower(value));
+      h.nativeType = NrrdNativeType(ToLower(value));
+    }
+    else if (field == "endian")
+    {
+      h.bigEndian = ToLower(value) == "big";
+    }
+    else if (field == "byte skip" || field == "byteskip" || field == "line skip" || field == "lineskip")
+    {
+      h.skips = value != "0";
     }
     else if (field == "data file" || field == "datafile")
     {
@@ -359,7 +390,7 @@ void CheckNrrdDataSize(const NrrdHeader& h, const std::string& path)
     encoding = DataEncoding::Raw; // hex: two characters a byte
   if (h.encoding == "ascii" || h.encoding == "text" || h.encoding == "txt")
     encoding = DataEncoding::Text;
-  CheckDeclaredVoxelBytes(path, count * h.typeSize, count, std::max(0.0, fileBytes), encoding);
+  CheckDeclaredVoxelBytes(path, count * h.typeSize, count, std::max(0.0, fileBytes), encoding, h.dataFile);
 }
 
 // Per-axis signs that take coordinates of a NRRD space to LPS. Spaces
@@ -428,7 +459,7 @@ Affine3 NrrdIndexToWorld(const NrrdHeader& h, const std::vector<int>& spatial, c
 
 } // namespace
 
-void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/)
+void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions& options)
 {
   const NrrdHeader h = ParseNrrdHeader(path);
   const std::vector<int> spatial = NrrdSpatialAxes(h);
@@ -443,16 +474,32 @@ void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions&
       path + ": a NRRD volume needs 1 to 3 spatial axes, this one has " + std::to_string(spatial.size()));
 
   CheckNrrdDataSize(h, path);
+  for (int i = 0; i < 3; ++i)
+    out.dims[i] = i < (int)spatial.size() ? (int)h.sizes[spatial[i]] : 1;
+  out.indexToWorld = NrrdIndexToWorld(h, spatial, path);
+
+  // Raw voxels of a native type in one file: read in place, at the speed
+  // of the disk (or the page cache), in the file's own order.
+  if (h.encoding == "raw" && h.nativeType && !h.skips && !h.dataFileList && !h.dataFilePattern)
+  {
+    RawVoxels raw;
+    raw.path = path;
+    raw.file = h.dataFile.empty() ? path : (std::filesystem::path(path).parent_path() / h.dataFile).string();
+    raw.offset = h.dataFile.empty() ? (uint64_t)h.headerBytes : 0;
+    raw.count = out.VoxelCount();
+    raw.type = *h.nativeType;
+    raw.bigEndian = h.bigEndian;
+    ReadRawVoxels(raw, out, options);
+    return;
+  }
 
   vtkNew<vtkNrrdReader> reader;
   reader->SetFileName(path.c_str());
-  vtkImageData* image = RunReader(reader, path);
+  vtkImageData* image = RunReader(reader, path, options.progress);
   vtkDataArray* a = VoxelArray(image, path);
 
   // The axis layout comes from our header; the buffer is the same whatever
   // vtkNrrdReader made of the axes (x fastest either way).
-  for (int i = 0; i < 3; ++i)
-    out.dims[i] = i < (int)spatial.size() ? (int)h.sizes[spatial[i]] : 1;
   const int64_t values = (int64_t)a->GetNumberOfTuples() * a->GetNumberOfComponents();
   if (values != out.VoxelCount())
     throw InputError(path + ": holds " + std::to_string(values) + " voxels, expected " +
@@ -466,8 +513,6 @@ void LoadNrrd(const std::string& path, HostVolume& out, const VolumeLoadOptions&
     const int* vtkDims = image->GetDimensions();
     ReverseRuns(out, (int64_t)vtkDims[0] * a->GetNumberOfComponents(), vtkDims[1]);
   }
-
-  out.indexToWorld = NrrdIndexToWorld(h, spatial, path);
 }
 
 } // namespace mmrtm

@@ -57,6 +57,10 @@ struct VolumeLoadOptions
   // Receives each warning (one line, naming the file); null prints them to
   // stderr as "warning: ...".
   std::function<void(const std::string&)> warn;
+  // Receives the fraction of the voxels read so far (0 to 1), on the
+  // calling thread, where the format's reader can tell (raw NRRD, DICOM
+  // slices, VTK's readers); null reports nothing.
+  std::function<void(double)> progress;
 };
 
 HostVolume LoadVolume(const std::string& path, const std::string& name, const VolumeLoadOptions& options);

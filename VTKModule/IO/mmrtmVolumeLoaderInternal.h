@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -93,10 +95,45 @@ std::optional<VoxelType> NativeVoxelType(SourceType t);
 
 // Stores `count` voxels of `type` into `out` (type and voxels), applying the
 // rescale and choosing the voxel type by the rules in mmrtmVolumeLoader.h.
-// With narrowFloats, float32 voxels that are all integers (a DICOM slice read
-// as float) also take the smallest exact integer type.
-void StoreVoxels(
-  const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out, bool narrowFloats = false);
+void StoreVoxels(const void* data, SourceType type, int64_t count, Rescale rescale, HostVolume& out);
+
+// The range of a set of values and whether all are integers (NaN and
+// infinities are not).
+struct ValueStats
+{
+  bool allIntegers = true;
+  double lo = std::numeric_limits<double>::infinity(), hi = -std::numeric_limits<double>::infinity();
+  void Add(const ValueStats& other);
+};
+ValueStats ScanFloatValues(const float* values, int64_t count);
+
+// The smallest integer type that holds every value exactly, else float32.
+// int16 is preferred over uint16 when both fit: CT and most medical data are signed.
+VoxelType SmallestExactType(const ValueStats& s);
+
+// Slices decoded one at a time (as float: a DICOM slice after its rescale)
+// gathered into a volume of the smallest voxel type that holds every value
+// put so far exactly (SmallestExactType), so that no float volume is held
+// on the way (mmrtmSliceStack.cxx). A slice that needs a wider type widens
+// the slices stored before it, once per type.
+class SliceStack
+{
+public:
+  SliceStack(int64_t sliceVoxels, int slices);
+  // Slice `index`'s values; `stats` as ScanFloatValues gives them.
+  void Put(int index, const float* values, const ValueStats& stats);
+  // Moves the volume into `out` (type and voxels). Slices never put are 0.
+  void MoveInto(HostVolume& out);
+
+private:
+  void Widen(VoxelType type);
+
+  int64_t sliceVoxels_;
+  int slices_;
+  ValueStats stats_;
+  VoxelType type_ = VoxelType::UInt8;
+  std::vector<uint8_t> voxels_;
+};
 
 // Throws InputError naming `path` when `bytes` (the voxels about to be
 // allocated, described by `what`) exceed the memory this machine has
@@ -118,8 +155,9 @@ enum class DataEncoding
 // CheckMemoryAvailable. Throws InputError naming `path`: a truncated file or
 // a corrupt header ("sizes" that promise terabytes) is an error, not an
 // allocation attempt.
-void CheckDeclaredVoxelBytes(
-  const std::string& path, double declaredBytes, double count, double fileBytes, DataEncoding encoding);
+// `dataFile` names a detached data file in the message ("" for the file itself).
+void CheckDeclaredVoxelBytes(const std::string& path, double declaredBytes, double count, double fileBytes,
+  DataEncoding encoding, const std::string& dataFile = "");
 
 // A printf format that names the files of a series (NRRD's `data file:
 // <format> ...`, MetaImage's `ElementDataFile = <pattern> ...`): both
@@ -135,6 +173,27 @@ void Warn(const VolumeLoadOptions& options, const std::string& message);
 // block of `runsPerBlock` runs. With runs of one row (nx voxels) and blocks of
 // one slice this flips y; with runs of one slice and one block it flips z.
 void ReverseRuns(HostVolume& v, int64_t runVoxels, int64_t runsPerBlock);
+
+// ---------------------------------------------------------------------------
+// Raw voxels (mmrtmRawVoxelReader.cxx)
+// ---------------------------------------------------------------------------
+
+// Voxels stored uncompressed, x fastest, in one file.
+struct RawVoxels
+{
+  std::string path;                  // the input, named in messages
+  std::string file;                  // the file that holds the voxels (`path` when attached)
+  uint64_t offset = 0;               // where they start in `file`
+  int64_t count = 0;                 // how many
+  VoxelType type = VoxelType::UInt8; // a type the tracer samples natively
+  bool bigEndian = false;
+};
+
+// Reads the voxels straight into `out` (type and voxels: a buffer of its
+// own, filled by all threads at once, bytes swapped to this machine's
+// order), reporting options.progress. Throws InputError naming the input
+// when the file cannot be opened or ends early (nothing is kept then).
+void ReadRawVoxels(const RawVoxels& raw, HostVolume& out, const VolumeLoadOptions& options);
 
 // ---------------------------------------------------------------------------
 // VTK glue (mmrtmVtkReaderGlue.cxx)
@@ -158,9 +217,11 @@ private:
   std::unique_ptr<Watch> watch_;
 };
 
-// Runs a reader and returns its image, which the reader owns. Throws
-// InputError when the reader fails or produces no voxels.
-vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path);
+// Runs a reader and returns its image, which the reader owns, passing the
+// reader's progress events to `progress`. Throws InputError when the reader
+// fails or produces no voxels.
+vtkImageData* RunReader(
+  vtkAlgorithm* reader, const std::string& path, const std::function<void(double)>& progress = {});
 
 // The point-data array that holds the voxels: the active scalars, else the
 // only point array (VTI files need not mark their scalars active).

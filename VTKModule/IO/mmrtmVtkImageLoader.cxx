@@ -159,14 +159,14 @@ void CheckVtiAppendedData(const std::string& path)
 
 } // namespace
 
-void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/)
+void LoadVti(const std::string& path, HostVolume& out, const VolumeLoadOptions& options)
 {
   vtkNew<vtkXMLImageDataReader> reader;
   if (!reader->CanReadFile(path.c_str()))
     throw InputError(path + ": not a VTK XML ImageData file");
   CheckVtiAppendedData(path);
   reader->SetFileName(path.c_str());
-  vtkImageData* image = RunReader(reader, path);
+  vtkImageData* image = RunReader(reader, path, options.progress);
   StoreImageVoxels(image, path, Rescale{}, out);
   out.indexToWorld = VtkImageIndexToWorld(image);
 }
@@ -237,7 +237,7 @@ void CheckDatasetFieldData(const std::string& path)
 
 } // namespace
 
-void LoadLegacyVtk(const std::string& path, HostVolume& out, const VolumeLoadOptions& /*options*/)
+void LoadLegacyVtk(const std::string& path, HostVolume& out, const VolumeLoadOptions& options)
 {
   vtkNew<vtkStructuredPointsReader> reader;
   reader->SetFileName(path.c_str());
@@ -250,7 +250,7 @@ void LoadLegacyVtk(const std::string& path, HostVolume& out, const VolumeLoadOpt
     }
   }
   CheckDatasetFieldData(path);
-  vtkImageData* image = RunReader(reader, path);
+  vtkImageData* image = RunReader(reader, path, options.progress);
   StoreImageVoxels(image, path, Rescale{}, out);
   out.indexToWorld = VtkImageIndexToWorld(image);
 }

@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include <vtkAlgorithm.h>
+#include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkErrorCode.h>
@@ -168,7 +170,7 @@ void ReaderErrors::ThrowIfFailed(const std::string& path) const
     throw InputError(path + ": cannot read (the reader failed)");
 }
 
-vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path)
+vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path, const std::function<void(double)>& progress)
 {
   ReaderErrors errors(reader);
   // The header first: a volume too large for this machine is refused before
@@ -188,7 +190,16 @@ vtkImageData* RunReader(vtkAlgorithm* reader, const std::string& path)
       "reading " + std::to_string((long long)nx) + " x " + std::to_string((long long)ny) + " x " +
         std::to_string((long long)nz) + " voxels");
   }
+  vtkNew<vtkCallbackCommand> onProgress;
+  if (progress)
+  {
+    onProgress->SetClientData(const_cast<std::function<void(double)>*>(&progress));
+    onProgress->SetCallback([](vtkObject*, unsigned long, void* client, void* fraction)
+      { (*static_cast<const std::function<void(double)>*>(client))(*static_cast<double*>(fraction)); });
+    reader->AddObserver(vtkCommand::ProgressEvent, onProgress);
+  }
   reader->Update();
+  reader->RemoveObserver(onProgress);
   errors.ThrowIfFailed(path);
   vtkImageData* image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));
   if (!image)

@@ -1,8 +1,10 @@
 #include "majorant_grid.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <thread>
 #include <type_traits>
 
 #include "parallel_for.h"
@@ -100,7 +102,8 @@ int64_t MajorantGrid::LeafCount() const {
   return (int64_t)view_.res[L][0] * view_.res[L][1] * view_.res[L][2];
 }
 
-void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantGridOptions& options) {
+void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantGridOptions& options,
+                         const std::function<void(double)>& progress) {
   const auto start = Clock::now();
   options_ = options;
   proxyCount_ = (int)proxies.size();
@@ -180,20 +183,29 @@ void MajorantGrid::Build(const std::vector<HostVolume>& proxies, const MajorantG
     const int L = view_.leafLevel;
     const int lo[3] = {0, 0, 0}, hi[3] = {view_.res[L][0] - 1, view_.res[L][1] - 1, view_.res[L][2] - 1};
     leafSummaryIds_.resize((size_t)LeafCount());
-    SummarizeRegion(proxies, lo, hi);
+    SummarizeRegion(proxies, lo, hi, progress);
   }
   buildSeconds_ = SecondsSince(start);
 }
 
-void MajorantGrid::SummarizeRegion(const std::vector<HostVolume>& proxies, const int lo[3], const int hi[3]) {
-  // Every leaf of the box in full first (in parallel), then each takes the
-  // id of its summary (in order, so that ids do not depend on threads).
+void MajorantGrid::SummarizeRegion(const std::vector<HostVolume>& proxies, const int lo[3], const int hi[3],
+                                   const std::function<void(double)>& progress) {
+  // Every leaf of the box in full first (in parallel, a layer of leaves at
+  // a time), then each takes the id of its summary (in order, so that ids
+  // do not depend on threads).
   const int L = view_.leafLevel, n[3] = {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1};
   const size_t stride = (size_t)proxyCount_ * kSummaryWords;
   std::vector<uint64_t> tuples((size_t)n[0] * n[1] * n[2] * stride, 0ull);
-  ParallelFor(n[2], options_.threads, [&](int64_t z0, int64_t z1) {
-    BuildLeaves(proxies, lo[2] + (int)z0, lo[2] + (int)z1, lo, hi, tuples.data());
+  std::atomic<int> nextLayer{0}, layersDone{0};
+  const int threads = options_.threads > 0 ? options_.threads : (int)std::max(1u, std::thread::hardware_concurrency());
+  RunWorkers(std::min(threads, n[2]), [&](int worker) {
+    for (int z = nextLayer++; z < n[2]; z = nextLayer++) {
+      BuildLeaves(proxies, lo[2] + z, lo[2] + z + 1, lo, hi, tuples.data());
+      ++layersDone;
+      if (worker == 0 && progress) progress((double)layersDone / n[2]);
+    }
   });
+  if (progress) progress(1.0);
   const uint64_t* tuple = tuples.data();
   for (int z = lo[2]; z <= hi[2]; ++z)
     for (int y = lo[1]; y <= hi[1]; ++y)

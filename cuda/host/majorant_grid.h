@@ -40,6 +40,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "host_volume.h"
@@ -74,8 +75,11 @@ constexpr float kPositionTolerance = 1e-3f;  // voxels; see "Rounding" above
 
 class MajorantGrid {
  public:
-  // Lays out the levels over proxy 0 and builds every leaf's summary.
-  void Build(const std::vector<HostVolume>& proxies, const MajorantGridOptions& options);
+  // Lays out the levels over proxy 0 and builds every leaf's summary,
+  // reporting the fraction of leaves done to `progress` on the calling
+  // thread (a summary build reads every voxel: seconds for gigabytes).
+  void Build(const std::vector<HostVolume>& proxies, const MajorantGridOptions& options,
+             const std::function<void(double)>& progress = {});
   // Rebuilds the summaries of the leaves that overlap the voxel box
   // [lo, hi] (inclusive, in proxy 0's index space) after the data there changed.
   void UpdateRegion(const std::vector<HostVolume>& proxies, std::array<int, 3> lo, std::array<int, 3> hi);
@@ -130,7 +134,8 @@ class MajorantGrid {
                    uint64_t* tuples);
   void SummarizeLeaf(const std::vector<HostVolume>& proxies, int lx, int ly, int lz, uint64_t* tuple);
   // Summarizes the leaves [lo, hi] (inclusive) and gives them their ids.
-  void SummarizeRegion(const std::vector<HostVolume>& proxies, const int lo[3], const int hi[3]);
+  void SummarizeRegion(const std::vector<HostVolume>& proxies, const int lo[3], const int hi[3],
+                       const std::function<void(double)>& progress = {});
   void RefitFromVoxelValues(const Classifier& classifier);
   void RefitUpperLevels();
 

@@ -24,4 +24,17 @@ void ParallelFor(int64_t n, int threads, Fn fn) {
   for (std::thread& t : pool) t.join();
 }
 
+// Calls worker(t) for t in [0, threads) (0: all hardware threads), worker
+// 0 on the calling thread: the one that may report progress to a caller
+// that is not thread-safe (a VTK observer, a terminal). Workers that share
+// work take it from an atomic counter. Workers must not throw.
+template <typename Fn>
+void RunWorkers(int threads, Fn worker) {
+  if (threads <= 0) threads = (int)std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+  worker(0);
+  for (std::thread& t : pool) t.join();
+}
+
 }  // namespace mmrtm

@@ -402,7 +402,7 @@ SceneView Scene::Build() {
     gridBuilt_ = !grid_ || dataModified_ || layoutChanged;
     if (gridBuilt_) {
       if (!grid_) grid_ = std::make_unique<MajorantGrid>();
-      grid_->Build(proxies, o);
+      grid_->Build(proxies, o, buildProgress);
     } else {
       for (const auto& region : modifiedRegions_) grid_->UpdateRegion(proxies, region[0], region[1]);
     }

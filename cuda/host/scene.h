@@ -3,6 +3,7 @@
 // that the backends trace. Host-only set-up code.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -114,6 +115,11 @@ class Scene {
     Affine3 worldToData;
     float lo[3] = {0.f, 0.f, 0.f}, hi[3] = {0.f, 0.f, 0.f};
   } cropping;
+
+  // Receives the fraction of the majorant grid's summary build done, on
+  // the thread that calls Build, when a Build reads every voxel (a new
+  // volume); null reports nothing.
+  std::function<void(double)> buildProgress;
 
   int ProxyIndex(const std::string& name) const;  // -1 if absent
   int MaterialIndex(const std::string& name) const;
