@@ -251,6 +251,39 @@ TEST(DicomLoader, ShuffledFileNamesGiveTheSameVolume) {
     for (int c = 0; c < 4; ++c) EXPECT_FLOAT_EQ(shuffled.indexToWorld.m[r][c], original.indexToWorld.m[r][c]);
 }
 
+// Slices are decoded one at a time into the smallest exact type. When a
+// later slice holds values that type cannot (a rescale intercept moved to
+// +40000: above int16, with air below 0), the slices stored before are
+// widened: the volume becomes float, every value exact. Catches slices
+// stored into the narrow type before the widening (wrapped values), and
+// the widening converting the earlier slices wrongly. Loading reports its
+// progress slice by slice, up to 1.
+TEST(DicomLoader, ASliceBeyondTheFirstSlicesTypeWidensTheWholeVolume) {
+  const std::string folder = ScratchFolder("widened");
+  const auto headers = SortedHeaders("ct_chest_dicom");
+  for (size_t i = 0; i < headers.size(); ++i) {
+    const fs::path copy = fs::path(folder) / headers[i].first.filename();
+    fs::copy_file(headers[i].first, copy);
+    if (i >= 60) RewriteElement(copy, gdcm::Tag(0x0028, 0x1052), "40000");
+  }
+  std::vector<double> fractions;
+  VolumeLoadOptions options;
+  options.progress = [&](double f) { fractions.push_back(f); };
+  const HostVolume v = LoadVolume(folder, "scalars", options);
+  const HostVolume original = LoadVolume(Data("ct_chest_dicom"));
+  ASSERT_EQ(original.type, VoxelType::Int16);
+  EXPECT_EQ(v.type, VoxelType::Float32);
+  ASSERT_EQ(v.dims, original.dims);
+  for (auto [i, j] : {std::pair{0, 0}, std::pair{256, 256}, std::pair{100, 300}, std::pair{400, 200}})
+    for (int k : {0, 30, 59, 60, 91}) {
+      SCOPED_TRACE("voxel " + std::to_string(i) + ", " + std::to_string(j) + ", " + std::to_string(k));
+      EXPECT_EQ(ValueAt(v, i, j, k), ValueAt(original, i, j, k) + (k >= 60 ? 41000.f : 0.f));
+    }
+  EXPECT_EQ(fractions.size(), headers.size());
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+  EXPECT_EQ(fractions.back(), 1.0);
+}
+
 // A missing slice: resampled onto the regular grid, with a warning; the
 // missing slice is the average of its neighbours (halfway between them).
 TEST(DicomLoader, MissingSliceIsResampledWithAWarning) {
