@@ -326,6 +326,24 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(s.counts(), (1, 1, 3))
         self.assertEqual(s.mapper.GetNumberOfMajorantGridRefits(), refits)
 
+    def test_a_new_volume_reports_its_summary_build_as_progress(self):
+        """The first render of a volume builds the majorant grid's summaries
+        (every voxel read: seconds for gigabytes); the mapper reports it as
+        VTK's ProgressEvent, up to 1, on the render thread. A camera move
+        reads no voxels: no progress. Catches a build that tells the
+        application nothing."""
+        s = Scene()
+        fractions = []
+        s.mapper.AddObserver("ProgressEvent", lambda mapper, event: fractions.append(mapper.GetProgress()))
+        s.render()
+        self.assertGreater(len(fractions), 1)
+        self.assertEqual(fractions, sorted(fractions))
+        self.assertEqual(fractions[-1], 1.0)
+        fractions.clear()
+        s.renderer.GetActiveCamera().Azimuth(10)
+        s.render()
+        self.assertEqual(fractions, [], "a camera move builds nothing")
+
     def test_data_change_rebuilds(self):
         s = Scene()
         s.render()

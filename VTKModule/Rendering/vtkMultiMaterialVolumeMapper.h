@@ -63,6 +63,7 @@ namespace mmrtm
 class Film;
 struct ClipPlane;
 struct ProjectionSettings;
+struct SceneView;
 }
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper
@@ -583,6 +584,7 @@ private:
   void TakeFilm(const InputState& now);
   void UpdateRenderer();
   mmrtm::ProjectionSettings Projection(vtkVolumeProperty* property);
+  mmrtm::SceneView BuildScene(); // the scene's Build, its summary build reported as VTK progress
   const mmrtm::Film* Refine(bool restart);
   double RenderPreview(vtkRenderer* ren, int width, int height); // the tracing's seconds
   void AdaptPreview(double seconds, double tracedSeconds, double budgetSeconds);
