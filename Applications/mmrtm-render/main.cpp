@@ -97,7 +97,7 @@ options:
                         first collide, N samples per pixel (default 0: colour only;
                         16 keeps more edges, for about a third of a 16-spp render)
   --stats-json FILE     timings, samples, collisions, density lookups and noise
-  --quiet               no progress bar
+  --quiet               no progress bars (loading, building, rendering)
   --help                this text
 )";
 
