@@ -101,6 +101,7 @@ void vtkSlicerMultiMaterialVolumeRenderingLogic::ApplyRenderSettings(
   mapper->SetSamplesPerRender(node->GetSamplesPerRender());
   mapper->SetMaximumSamples(node->GetMaximumSamples());
   mapper->SetNoiseTarget(node->GetNoiseTarget());
+  mapper->SetAsynchronousRefinement(node->GetAsynchronousRefinement());
   mapper->SetMaximumBounces(node->GetMaximumBounces());
   mapper->SetShadowExtinctionScale(node->GetShadowExtinctionScale());
   mapper->SetSeed(node->GetSeed());

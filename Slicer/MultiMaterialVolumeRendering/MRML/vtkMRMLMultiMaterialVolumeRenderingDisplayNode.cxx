@@ -10,6 +10,7 @@
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkStringArray.h>
+#include <vtkVersionMacros.h>
 
 #include <cctype>
 #include <cstring>
@@ -17,6 +18,43 @@
 #include <sstream>
 
 vtkMRMLNodeNewMacro(vtkMRMLMultiMaterialVolumeRenderingDisplayNode);
+
+namespace
+{
+// Creates the display node by its class name for vtkObjectFactory::CreateInstance.
+class NodeFactory : public vtkObjectFactory
+{
+public:
+  static NodeFactory* New()
+  {
+    auto* factory = new NodeFactory;
+    factory->InitializeObjectBase();
+    return factory;
+  }
+  vtkTypeMacro(NodeFactory, vtkObjectFactory);
+  const char* GetVTKSourceVersion() override { return VTK_SOURCE_VERSION; }
+  const char* GetDescription() override { return "MM-RTM volume rendering display node"; }
+
+protected:
+  NodeFactory()
+  {
+    this->RegisterOverride("vtkMRMLMultiMaterialVolumeRenderingDisplayNode",
+      "vtkMRMLMultiMaterialVolumeRenderingDisplayNode", "the MM-RTM display node by class name", 1,
+      []() -> vtkObject* { return vtkMRMLMultiMaterialVolumeRenderingDisplayNode::New(); });
+  }
+};
+} // namespace
+
+void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::RegisterNodeFactory()
+{
+  static const bool registered = []
+  {
+    vtkNew<NodeFactory> factory;
+    vtkObjectFactory::RegisterFactory(factory);
+    return true;
+  }();
+  (void)registered;
+}
 
 namespace
 {
@@ -211,6 +249,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::WriteXML(ostream& of, int n
   vtkMRMLWriteXMLIntMacro(samplesPerRender, SamplesPerRender);
   vtkMRMLWriteXMLIntMacro(maximumSamples, MaximumSamples);
   vtkMRMLWriteXMLFloatMacro(noiseTarget, NoiseTarget);
+  vtkMRMLWriteXMLBooleanMacro(asynchronousRefinement, AsynchronousRefinement);
   vtkMRMLWriteXMLIntMacro(maximumBounces, MaximumBounces);
   vtkMRMLWriteXMLFloatMacro(shadowExtinctionScale, ShadowExtinctionScale);
   vtkMRMLWriteXMLEnumMacro(accelerator, Accelerator);
@@ -230,6 +269,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::ReadXMLAttributes(const cha
   vtkMRMLReadXMLIntMacro(samplesPerRender, SamplesPerRender);
   vtkMRMLReadXMLIntMacro(maximumSamples, MaximumSamples);
   vtkMRMLReadXMLFloatMacro(noiseTarget, NoiseTarget);
+  vtkMRMLReadXMLBooleanMacro(asynchronousRefinement, AsynchronousRefinement);
   vtkMRMLReadXMLIntMacro(maximumBounces, MaximumBounces);
   vtkMRMLReadXMLFloatMacro(shadowExtinctionScale, ShadowExtinctionScale);
   vtkMRMLReadXMLEnumMacro(accelerator, Accelerator);
@@ -265,6 +305,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::CopyContent(vtkMRMLNode* an
     vtkMRMLCopyIntMacro(SamplesPerRender);
     vtkMRMLCopyIntMacro(MaximumSamples);
     vtkMRMLCopyFloatMacro(NoiseTarget);
+    vtkMRMLCopyBooleanMacro(AsynchronousRefinement);
     vtkMRMLCopyIntMacro(MaximumBounces);
     vtkMRMLCopyFloatMacro(ShadowExtinctionScale);
     vtkMRMLCopyEnumMacro(Accelerator);
@@ -289,6 +330,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::PrintSelf(ostream& os, vtkI
   vtkMRMLPrintIntMacro(SamplesPerRender);
   vtkMRMLPrintIntMacro(MaximumSamples);
   vtkMRMLPrintFloatMacro(NoiseTarget);
+  vtkMRMLPrintBooleanMacro(AsynchronousRefinement);
   vtkMRMLPrintIntMacro(MaximumBounces);
   vtkMRMLPrintFloatMacro(ShadowExtinctionScale);
   vtkMRMLPrintEnumMacro(Accelerator);

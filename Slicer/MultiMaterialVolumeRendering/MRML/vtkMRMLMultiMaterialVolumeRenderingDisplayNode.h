@@ -39,6 +39,14 @@ public:
   vtkTypeMacro(vtkMRMLMultiMaterialVolumeRenderingDisplayNode, vtkMRMLVolumeRenderingDisplayNode);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  /// Lets any MRML scene create this node by its class name, through VTK's
+  /// object factory (vtkMRMLScene::CreateNodeByClass asks it for classes
+  /// that scene has not registered): Volume Rendering's logic can then make
+  /// this method's display node even in a scene where this module's logic
+  /// was never registered (trame-slicer), instead of dereferencing the null
+  /// node it got before. Idempotent; importing mmrtm_slicer calls it.
+  static void RegisterNodeFactory();
+
   vtkMRMLNode* CreateNodeInstance() override;
   const char* GetNodeTagName() override { return "MultiMaterialVolumeRendering"; }
   void ReadXMLAttributes(const char** atts) override;
@@ -58,6 +66,17 @@ public:
   /// Samples per pixel after which refinement stops (default 256; 0: no limit).
   vtkSetClampMacro(MaximumSamples, int, 0, VTK_INT_MAX);
   vtkGetMacro(MaximumSamples, int);
+  ///@}
+
+  ///@{
+  /// Refinement in the background (default off;
+  /// vtkMultiMaterialVolumeMapper::AsynchronousRefinement): a render
+  /// returns at once with the last finished image while the next pass runs
+  /// on the tracer's threads, so that an application's event loop (a web
+  /// server streaming frames) stays free between passes.
+  vtkSetMacro(AsynchronousRefinement, bool);
+  vtkGetMacro(AsynchronousRefinement, bool);
+  vtkBooleanMacro(AsynchronousRefinement, bool);
   ///@}
 
   ///@{
@@ -169,6 +188,7 @@ protected:
   int SamplesPerRender = 4;
   int MaximumSamples = 256;
   double NoiseTarget = 0.0;
+  bool AsynchronousRefinement = false;
   int MaximumBounces = 32;
   double ShadowExtinctionScale = 0.8;
   int Accelerator = Octree;

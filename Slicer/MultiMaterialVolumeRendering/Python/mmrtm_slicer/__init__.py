@@ -6,7 +6,8 @@ vtkMRMLMultiMaterialVolumeRenderingDisplayNode (the display node),
 vtkSlicerMultiMaterialVolumeRenderingLogic (the rendering method "Path
 tracing (MM-RTM)") and vtkMRMLMultiMaterialVolumeRenderingPipeline (the
 LayerDM pipeline that renders the node in 3D views; importing this package
-registers its creator). They are also reachable as `from slicer import ...`.
+registers its creator, and a factory that lets any scene create the display
+node by class name). They are also reachable as `from slicer import ...`.
 """
 # The libraries and Python types of the classes ours derive from first.
 import slicer_core  # noqa: F401
@@ -18,3 +19,7 @@ from .vtkSlicerMultiMaterialVolumeRenderingModuleLogic import *  # noqa: F401,F4
 from .vtkSlicerMultiMaterialVolumeRenderingModuleMRMLDisplayableManager import *  # noqa: F401,F403
 
 vtkMRMLMultiMaterialVolumeRenderingPipeline.RegisterPipelineCreator()  # noqa: F405
+# Any scene can then create the display node by class name, so that Volume
+# Rendering's logic set to this method before this module's logic is
+# registered (trame-slicer) makes the node instead of crashing.
+vtkMRMLMultiMaterialVolumeRenderingDisplayNode.RegisterNodeFactory()  # noqa: F405

@@ -40,7 +40,7 @@ def presets_directory():
 
 
 class SlicerScene:
-    def __init__(self):
+    def __init__(self, with_our_logic=True):
         self.scene = vtkMRMLScene()
         self.app = vtkSlicerApplicationLogic()
         self.app.SetMRMLScene(self.scene)
@@ -55,8 +55,11 @@ class SlicerScene:
                                               presets_directory())
         self.segmentations = self.register(vtkSlicerSegmentationsModuleLogic(), "Segmentations")
         # Ours last, as a Slicer module after its dependencies: it finds the
-        # Volume Rendering logic through the application logic.
-        self.logic = self.register(vtkSlicerMultiMaterialVolumeRenderingLogic(), "MultiMaterialVolumeRendering")
+        # Volume Rendering logic through the application logic. Without it,
+        # as trame-slicer starts, only the package's import has run.
+        self.logic = None
+        if with_our_logic:
+            self.logic = self.register(vtkSlicerMultiMaterialVolumeRenderingLogic(), "MultiMaterialVolumeRendering")
         self.views = []
 
     def register(self, logic, name, share_directory=None):

@@ -9,7 +9,10 @@ Run by ctest under Testing/headless.sh (its own Xvfb) with the .venv-vtk96 inter
 mmrtm wheel (with its Slicer classes) was built and installed there.
 """
 import os
+import subprocess
+import sys
 import tempfile
+import time
 import unittest
 
 from vtkmodules.vtkCommonDataModel import vtkImageData
@@ -46,6 +49,30 @@ class MethodTest(unittest.TestCase):
         self.assertTrue(s.logic.IsRenderingMethodRegistered())
         self.assertTrue(s.scene.IsNodeClassRegistered(METHOD))
         self.assertEqual(s.logic.GetRenderingMethodName(), "Path tracing (MM-RTM)")
+
+    @NEEDS_PRESETS
+    def test_our_method_chosen_before_our_logic_is_registered_renders(self):
+        """trame-slicer registers the module logics it knows; a script that
+        sets our method as Volume Rendering's default without registering
+        ours made CreateDefaultVolumeRenderingNodes dereference a null node
+        (a segfault, exit 139). The package's import lets any scene create
+        the node by class name: the node is ours and the view path traces.
+        In a child process, so that a crash fails this test only."""
+        script = (
+            "from slicer_test_scene import SlicerScene, DATA\n"
+            "import os\n"
+            "s = SlicerScene(with_our_logic=False)\n"
+            "assert not s.scene.IsNodeClassRegistered('%s')\n"
+            "view = s.add_view()\n"
+            "volume = s.load_volume(os.path.join(DATA, 'ct_head_cranium.nrrd'), 'head')\n"
+            "display = s.show_with_path_tracing(volume)\n"
+            "view.look_at_volume(azimuth=180)\n"
+            "view.refine()\n"
+            "print(display.GetClassName(), view.mapper().GetAccumulatedSamples())\n" % METHOD)
+        child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                               cwd=os.path.dirname(os.path.abspath(__file__)))
+        self.assertEqual(child.returncode, 0, child.stderr[-2000:])
+        self.assertEqual(child.stdout.split()[-2:], [METHOD, "8"])
 
     def test_from_slicer_import(self):
         import slicer
@@ -204,6 +231,24 @@ class ViewTest(unittest.TestCase):
         self.view.render()
         self.assertEqual(self.view.mapper().GetAccumulatedSamples(), 4, "restarted")
         self.assertEqual(self.counts()[1], refits + 2)
+
+    def test_background_refinement_is_a_display_node_setting(self):
+        """AsynchronousRefinement on the display node reaches the mapper: a
+        render returns at once while the next pass runs, and the image still
+        converges to the same film. Catches a setting that is stored but not
+        applied."""
+        synchronous = film(self.view.mapper())
+        self.display.SetAsynchronousRefinement(True)
+        self.view.render()
+        mapper = self.view.mapper()
+        self.assertTrue(mapper.GetAsynchronousRefinement())
+        deadline = time.monotonic() + 60
+        while not mapper.IsConverged() and time.monotonic() < deadline:
+            time.sleep(0.02)
+            self.view.render()
+        self.assertTrue(mapper.IsConverged())
+        self.assertEqual(mapper.GetAccumulatedSamples(), 8)
+        self.assertEqual(film(mapper), synchronous, "the same film in the background")
 
     def test_refinement_stops_at_the_noise_target(self):
         self.display.SetMaximumSamples(0)
@@ -379,6 +424,7 @@ class SceneFileTest(unittest.TestCase):
         view.look_at_volume(azimuth=180)
         view.refine()
         first = film(view.mapper())
+        display.SetAsynchronousRefinement(True)  # saved; set off again below, to refine in step
         with tempfile.TemporaryDirectory() as folder:
             self.assertTrue(s.app.SaveSceneToSlicerDataBundleDirectory(folder, None))
             mrml = [f for f in os.listdir(folder) if f.endswith(".mrml")][0]
@@ -392,6 +438,8 @@ class SceneFileTest(unittest.TestCase):
                               loaded.GetAccelerator(), loaded.GetSamplesPerRender(), loaded.GetMaximumSamples()),
                              (11, 5, 1.0, display.Macrocell, 4, 8))
             self.assertEqual(loaded.GetSegmentMaterialParameters("S_x=1;"), '{"roughness": 0.25}')
+            self.assertTrue(loaded.GetAsynchronousRefinement())
+            loaded.SetAsynchronousRefinement(False)
             other = t.add_view()
             other.render()
             other.renderer.GetActiveCamera().DeepCopy(view.renderer.GetActiveCamera())
