@@ -1275,7 +1275,7 @@ void vtkMultiMaterialVolumeMapper::UpdateRenderer()
 
 mmrtm::SceneView vtkMultiMaterialVolumeMapper::BuildScene()
 {
-  // A new volume's summary build reads every voxel (13 s for 8 GiB on two
+  // A new volume's summary build reads every voxel (14 s for 8 GiB on two
   // cores): VTK's ProgressEvent tells the application, on this thread.
   mmrtm::Scene& scene = this->Internal->Scene;
   scene.buildProgress = [this](double fraction) { this->UpdateProgress(fraction); };
