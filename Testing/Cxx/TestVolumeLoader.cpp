@@ -548,6 +548,78 @@ TEST(VolumeLoader, RawNrrdReadDirectlyEqualsTheVtkReadersVoxels) {
   }
 }
 
+// A MetaImage of the values of WriteNrrdOfType's volume: uncompressed
+// (LOCAL in a .mha, or a detached .raw) in `order` (MSB: big endian), or
+// zlib-compressed (read by vtkMetaImageReader). Returns the header's path.
+std::string WriteMetaImageOfType(const std::string& name, const std::string& type, int size, bool compressed, bool msb,
+                                 bool detached) {
+  const int nx = 37, ny = 11, nz = 5;
+  std::vector<uint8_t> bytes((size_t)nx * ny * nz * size);
+  for (int i = 0; i < nx * ny * nz; ++i) {
+    uint8_t* v = bytes.data() + (size_t)i * size;
+    if (type == "MET_FLOAT") {
+      const float f = 0.25f * (float)i - 100.f;
+      std::memcpy(v, &f, 4);
+    } else {
+      const int value = type == "MET_SHORT" ? i - 1000 : i;
+      std::memcpy(v, &value, (size_t)size);
+    }
+    if (msb) std::reverse(v, v + size);
+  }
+  std::vector<uint8_t> data = bytes;
+  if (compressed) {
+    uLongf length = compressBound((uLong)bytes.size());
+    data.resize(length);
+    compress2(data.data(), &length, bytes.data(), (uLong)bytes.size(), 6);
+    data.resize(length);
+  }
+  const std::string path = Scratch(name + (detached ? ".mhd" : ".mha"));
+  const std::string dataName = name + (compressed ? ".zraw" : ".raw");
+  std::ofstream out(path, std::ios::binary);
+  out << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = " << (msb ? "True" : "False")
+      << "\nCompressedData = " << (compressed ? "True" : "False") << "\n";
+  if (compressed) out << "CompressedDataSize = " << data.size() << "\n";
+  out << "ElementSpacing = 0.5 0.75 2\nOffset = 10 20 30\nDimSize = " << nx << " " << ny << " " << nz
+      << "\nElementType = " << type << "\nElementDataFile = " << (detached ? dataName : "LOCAL") << "\n";
+  if (detached) {
+    out.close();
+    std::ofstream((fs::path(path).parent_path() / dataName).string(), std::ios::binary)
+        .write(reinterpret_cast<const char*>(data.data()), (std::streamsize)data.size());
+  } else {
+    out.write(reinterpret_cast<const char*>(data.data()), (std::streamsize)data.size());
+  }
+  return path;
+}
+
+// Uncompressed MetaImage data of a native type is read straight into the
+// volume; compressed data goes through vtkMetaImageReader. Both give the
+// same voxels, type and geometry: catches a wrong data offset (LOCAL after
+// the header, or a detached file), bytes not swapped from big endian, and
+// geometry that came from VTK's image before.
+TEST(VolumeLoader, RawMetaImageReadDirectlyEqualsTheVtkReadersVoxels) {
+  struct Type {
+    const char* name;
+    int size;
+    VoxelType voxelType;
+  };
+  for (const Type& t : {Type{"MET_UCHAR", 1, VoxelType::UInt8}, Type{"MET_SHORT", 2, VoxelType::Int16},
+                        Type{"MET_USHORT", 2, VoxelType::UInt16}, Type{"MET_FLOAT", 4, VoxelType::Float32}}) {
+    SCOPED_TRACE(t.name);
+    const HostVolume reference = LoadVolume(WriteMetaImageOfType("z", t.name, t.size, true, false, true));
+    ASSERT_EQ(reference.type, t.voxelType);
+    for (bool msb : {false, true})
+      for (bool detached : {false, true}) {
+        SCOPED_TRACE(std::string(msb ? "MSB" : "LSB") + (detached ? " detached" : " LOCAL"));
+        const HostVolume v = LoadVolume(WriteMetaImageOfType("raw", t.name, t.size, false, msb, detached));
+        EXPECT_EQ(v.type, t.voxelType);
+        EXPECT_EQ(v.dims, reference.dims);
+        EXPECT_TRUE(v.voxels == reference.voxels);
+        ExpectWorld(v, {1, 2, 3}, {10.5f, 21.5f, 36.f});
+        ExpectWorld(reference, {1, 2, 3}, {10.5f, 21.5f, 36.f});
+      }
+  }
+}
+
 // A raw data file shorter than its header's sizes, and a gzip stream cut
 // short: errors that name the file, no volume.
 TEST(VolumeLoader, ShortRawDataFileAndTruncatedGzipStreamAreErrors) {

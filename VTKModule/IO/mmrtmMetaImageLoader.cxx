@@ -1,6 +1,8 @@
-// MetaImage volumes (.mha, .mhd) through vtkMetaImageReader, with the
+// MetaImage volumes (.mha, .mhd): uncompressed 3D voxels of a native type
+// read straight into the volume (ReadRawVoxels), the others through
+// vtkMetaImageReader with a check that the voxel data is all there; the
 // geometry (Offset, ElementSpacing, TransformMatrix) read from the header
-// text and a check that the voxel data is all there.
+// text.
 #include "mmrtmVolumeLoaderInternal.h"
 
 #include <zlib.h>
@@ -335,6 +337,21 @@ void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint8
       std::to_string(bytes) + " (truncated?)");
 }
 
+// The voxel type of a MetaImage ElementType the tracer samples as it is;
+// nullopt for the others (read and converted through vtkMetaImageReader).
+std::optional<VoxelType> MetaNativeType(const std::string& type)
+{
+  if (type == "MET_UCHAR")
+    return VoxelType::UInt8;
+  if (type == "MET_SHORT")
+    return VoxelType::Int16;
+  if (type == "MET_USHORT")
+    return VoxelType::UInt16;
+  if (type == "MET_FLOAT")
+    return VoxelType::Float32;
+  return std::nullopt;
+}
+
 // The first of `keys` present with exactly `n` numbers.
 std::optional<std::vector<double>> MetaNumbers(
   const std::map<std::string, std::string>& fields, std::initializer_list<const char*> keys, size_t n)
@@ -360,19 +377,44 @@ void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOpt
   if (fields.find("ObjectType") == fields.end() && fields.find("NDims") == fields.end())
     throw InputError(path + ": not a MetaImage header (no ObjectType or NDims)");
   CheckMetaImageDeclaredSize(path, header);
-  vtkNew<vtkMetaImageReader> reader;
-  reader->SetFileName(path.c_str());
-  vtkImageData* image = RunReader(reader, path, options.progress);
-  vtkDataArray* a = VoxelArray(image, path);
-  CheckMetaImageData(path, header, static_cast<uint8_t*>(a->GetVoidPointer(0)),
-    (uint64_t)a->GetNumberOfValues() * (uint64_t)a->GetDataTypeSize(), a->GetDataTypeSize(), options);
-  StoreImageVoxels(image, path, Rescale{}, out);
-
-  // 2D images (NDims 2) keep VTK's origin and spacing, with an identity direction.
-  const double* o = image->GetOrigin();
-  const double* s = image->GetSpacing();
-  Vec3d origin{ o[0], o[1], o[2] }, spacing{ s[0], s[1], s[2] };
+  Vec3d origin{ 0, 0, 0 }, spacing{ 1, 1, 1 }; // metaio's defaults
   Mat3d direction = kIdentity3;
+
+  // Uncompressed 3D voxels of a native type in one file: read in place
+  // (ReadRawVoxels), in the file's order, as vtkMetaImageReader keeps it.
+  const std::optional<MetaImageData> data = LocateMetaImageData(path, header);
+  const std::optional<VoxelType> native = MetaNativeType(Field(header, "ElementType"));
+  const std::vector<int64_t> dims = PositiveIntegers(path, "DimSize", Field(header, "DimSize"));
+  const std::string channels = Field(header, "ElementNumberOfChannels");
+  if (data && !data->compressed && native && dims.size() == 3 && (channels.empty() || channels == "1"))
+  {
+    out.dims = { (int)dims[0], (int)dims[1], (int)dims[2] };
+    RawVoxels raw;
+    raw.path = path;
+    raw.file = data->file;
+    raw.offset = data->offset;
+    raw.count = out.VoxelCount();
+    raw.type = *native;
+    raw.bigEndian =
+      ToLower(Field(header, "BinaryDataByteOrderMSB") + Field(header, "ElementByteOrderMSB")).find("true") !=
+      std::string::npos;
+    ReadRawVoxels(raw, out, options);
+  }
+  else
+  {
+    vtkNew<vtkMetaImageReader> reader;
+    reader->SetFileName(path.c_str());
+    vtkImageData* image = RunReader(reader, path, options.progress);
+    vtkDataArray* a = VoxelArray(image, path);
+    CheckMetaImageData(path, header, static_cast<uint8_t*>(a->GetVoidPointer(0)),
+      (uint64_t)a->GetNumberOfValues() * (uint64_t)a->GetDataTypeSize(), a->GetDataTypeSize(), options);
+    StoreImageVoxels(image, path, Rescale{}, out);
+    // 2D images (NDims 2) keep VTK's origin and spacing.
+    const double* o = image->GetOrigin();
+    const double* s = image->GetSpacing();
+    origin = { o[0], o[1], o[2] };
+    spacing = { s[0], s[1], s[2] };
+  }
   if (auto v = MetaNumbers(fields, { "Offset", "Position", "Origin" }, 3))
     origin = { (*v)[0], (*v)[1], (*v)[2] };
   if (auto v = MetaNumbers(fields, { "ElementSpacing", "ElementSize" }, 3))
