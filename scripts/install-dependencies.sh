@@ -16,6 +16,7 @@ packages=(
   clang-14 libclang-rt-14-dev   # libFuzzer + sanitizer runtimes (Testing/Fuzz)
   invesalius-examples   # the default input: Cranium.inv3
   debootstrap           # the ParaView root of the plugin's build and tests (scripts/paraview-root.sh)
+  chromium chromium-driver   # mmrtm-web's test: a real browser, headless, driven by selenium
 )
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi

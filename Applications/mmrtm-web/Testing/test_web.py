@@ -1,0 +1,143 @@
+"""mmrtm-web in a real browser: Debian's chromium, headless, driven by
+selenium, against the console script started as a user starts it.
+
+Run by ctest with the .venv-vtk96 interpreter (the wheel with its Slicer
+classes and trame-slicer installed there), MMRTM_SHARED_DATA_DIR set, and
+MMRTM_TEST_OUTPUT_DIR for the screenshot (Documentation/web.md shows it).
+"""
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import unittest
+
+from selenium import webdriver
+from selenium.webdriver.chrome.options import Options
+from selenium.webdriver.chrome.service import Service
+
+DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
+OUTPUT = os.environ.get("MMRTM_TEST_OUTPUT_DIR", os.getcwd())
+CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+
+# The 3D view's frame: the largest streamed <img>, drawn into a canvas to
+# read its pixels. Returns [width, height, fraction of pixels that are not
+# the background's grey, mean brightness], or null before the first frame.
+FRAME_STATISTICS = """
+const images = Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
+if (!images.length) return null;
+const img = images.reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b);
+const canvas = document.createElement('canvas');
+canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+const context = canvas.getContext('2d');
+context.drawImage(img, 0, 0);
+const p = context.getImageData(0, 0, canvas.width, canvas.height).data;
+const corner = [p[0], p[1], p[2]];
+const kept = window.mmrtmKeptFrame;
+const comparable = kept && kept.length === p.length;
+let differ = 0, sum = 0, change = 0;
+for (let i = 0; i < p.length; i += 4) {
+  const d = Math.abs(p[i] - corner[0]) + Math.abs(p[i + 1] - corner[1]) + Math.abs(p[i + 2] - corner[2]);
+  if (d > 30) differ++;
+  sum += p[i] + p[i + 1] + p[i + 2];
+  if (comparable) change += Math.abs(p[i] - kept[i]) + Math.abs(p[i + 1] - kept[i + 1]) + Math.abs(p[i + 2] - kept[i + 2]);
+}
+if (arguments[0]) window.mmrtmKeptFrame = p;
+const n = p.length / 4;
+return [canvas.width, canvas.height, differ / n, sum / n / 3, comparable ? change / n / 3 : -1];
+"""
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class WebViewerTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        for program in (CHROMIUM, DRIVER):
+            if not os.path.exists(program):
+                raise RuntimeError(program + " is missing: scripts/install-dependencies.sh installs Debian's "
+                                   "chromium and chromium-driver")
+        os.makedirs(OUTPUT, exist_ok=True)
+        cls.port = free_port()
+        script = shutil.which("mmrtm-web", path=os.path.dirname(sys.executable))
+        cls.log = open(os.path.join(OUTPUT, "mmrtm-web-test.log"), "w")
+        cls.server = subprocess.Popen([script, os.path.join(DATA, "ct_head_cranium.nrrd"), "--port", str(cls.port)],
+                                      stdout=cls.log, stderr=subprocess.STDOUT)
+        options = Options()
+        for argument in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1200,800"):
+            options.add_argument(argument)
+        options.binary_location = CHROMIUM
+        cls.browser = webdriver.Chrome(service=Service(DRIVER), options=options)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.browser.quit()
+        cls.server.terminate()
+        cls.server.wait(timeout=30)
+        cls.log.close()
+
+    def open_page(self):
+        """Loads the page once the server answers (it loads the volume first)."""
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            self.assertIsNone(self.server.poll(), "the server exited: see mmrtm-web-test.log")
+            try:
+                with socket.create_connection(("127.0.0.1", self.port), timeout=1):
+                    break
+            except OSError:
+                time.sleep(0.25)
+        start = time.monotonic()
+        self.browser.get("http://127.0.0.1:%d/" % self.port)
+        return start
+
+    def frame(self, timeout, accept=lambda s: True, keep=False):
+        """Statistics of the 3D frame (FRAME_STATISTICS) once `accept` takes
+        them; `keep` keeps the frame to measure later frames' change from."""
+        deadline, statistics = time.monotonic() + timeout, None
+        while time.monotonic() < deadline:
+            statistics = self.browser.execute_script(FRAME_STATISTICS, keep)
+            if statistics and statistics[0] > 100 and accept(statistics):
+                return statistics
+            time.sleep(0.1)
+        self.fail("no 3D frame within %.0f s (last: %s)" % (timeout, statistics))
+
+    def test_the_page_shows_the_path_traced_head_and_a_preset_changes_it(self):
+        """The first path-traced frame reaches the browser, shows the head
+        (neither empty nor filled), and a preset chosen in the page changes
+        the image. Catches a server that never streams our view, a 3D view
+        rendered by another method or left black, and a preset menu that
+        does not reach the display node."""
+        start = self.open_page()
+        width, height, coverage, brightness, _ = self.frame(60, lambda s: 0.02 < s[2] < 0.95)
+        first_frame = time.monotonic() - start
+        print("first frame %.1f s after the page was asked for: %d x %d, coverage %.3f, brightness %.1f"
+              % (first_frame, width, height, coverage, brightness))
+        self.assertGreater(brightness, 5.0, "not a black image")
+        time.sleep(3)  # refinement goes on
+        self.browser.save_screenshot(os.path.join(OUTPUT, "mmrtm-web.png"))
+        # What refinement alone changes in a second, then a preset's change.
+        self.frame(5, keep=True)
+        time.sleep(1)
+        refinement = self.frame(5)[4]
+        # Slicer's CT-Muscle preset shows the skin and muscle CT-Bone leaves out.
+        self.browser.find_element("css selector", ".preset-select .v-field").click()
+        deadline, target, items = time.monotonic() + 10, [], []
+        while not target and time.monotonic() < deadline:
+            time.sleep(0.2)
+            items = self.browser.find_elements("css selector", ".v-list-item")
+            target = [i for i in items if i.text.strip() == "CT-Muscle"]
+        self.assertTrue(target, "the preset menu lists Slicer's presets: %s" % [i.text for i in items][:8])
+        target[0].click()
+        clicked = time.monotonic()
+        changed = self.frame(20, lambda s: s[4] > max(4.0, 2.5 * refinement))
+        print("the preset's image %.2f s after the click: mean change %.1f levels (refinement alone: %.1f)"
+              % (time.monotonic() - clicked, changed[4], refinement))
+
+
+if __name__ == "__main__":
+    unittest.main()

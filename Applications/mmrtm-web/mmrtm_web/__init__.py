@@ -1,0 +1,1 @@
+"""mmrtm-web: MM-RTM path tracing in a browser, on trame-slicer (Documentation/web.md)."""

@@ -1,0 +1,137 @@
+"""mmrtm-web: a study path traced by MM-RTM in a browser, on trame-slicer.
+
+    mmrtm-web [VOLUME_OR_DICOM_FOLDER] [--host 127.0.0.1] [--port 8080]
+
+Serves a page with Slicer's layouts (the 3D view path traced by our method,
+the axial, coronal and sagittal slices beside it) and Slicer's Volume
+Rendering presets. The 3D view refines in the background (the display
+node's AsynchronousRefinement), so the server answers the browser between
+sample passes. Documentation/web.md says what it does and does not do yet.
+"""
+import argparse
+import ipaddress
+import os
+import sys
+
+METHOD = "vtkMRMLMultiMaterialVolumeRenderingDisplayNode"
+DEFAULT_PRESET = "CT-Bone"
+
+
+def parse_arguments(argv):
+    parser = argparse.ArgumentParser(prog="mmrtm-web", description=__doc__.split("\n\n")[0])
+    parser.add_argument("volume", nargs="?", help="a volume file (NRRD, NIfTI, MetaImage) or a DICOM folder")
+    parser.add_argument("--host", default="127.0.0.1", help="address to serve on (default: loopback only)")
+    parser.add_argument("--port", type=int, default=8080, help="port (default 8080; 0: any free port)")
+    parser.add_argument("--preset", default=DEFAULT_PRESET, help="Volume Rendering preset (default CT-Bone)")
+    parser.add_argument("--maximum-samples", type=int, default=64, help="samples per pixel to refine to (default 64)")
+    return parser.parse_args(argv)
+
+
+def volume_files(path):
+    """The files Slicer's volumes reader gets for `path`: a DICOM folder's
+    files (sorted), or the file itself. Raises ValueError naming the problem."""
+    if os.path.isdir(path):
+        files = sorted(os.path.join(path, f) for f in os.listdir(path) if os.path.isfile(os.path.join(path, f)))
+        if not files:
+            raise ValueError("%s: the folder holds no files" % path)
+        return files
+    if not os.path.isfile(path):
+        raise ValueError("%s: no such file or folder" % path)
+    return [path]
+
+
+def is_loopback(host):
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return host == "localhost"
+
+
+class WebViewer:
+    """The trame server, the Slicer core behind it, and the page."""
+
+    def __init__(self, volume_path, preset=DEFAULT_PRESET, maximum_samples=64, server=None):
+        from trame.app import get_server
+        from trame.widgets import vuetify3
+        from trame_client.widgets.html import Div
+        from trame_slicer.core import LayoutManager, SlicerApp
+        from trame_slicer.rca_view import register_rca_factories
+        from trame_vuetify.ui.vuetify3 import SinglePageLayout
+        from slicer import vtkSlicerMultiMaterialVolumeRenderingLogic
+
+        self.server = get_server(server, client_type="vue3")
+        self.slicer = SlicerApp()
+        # Our method in Volume Rendering's list, as the Slicer module does.
+        self.slicer.register_module_logic(vtkSlicerMultiMaterialVolumeRenderingLogic(),
+                                          logic_name="MultiMaterialVolumeRendering")
+        self.volume_rendering = self.slicer.volume_rendering
+        self.volume_rendering._logic.SetDefaultRenderingMethod(METHOD)
+        register_rca_factories(self.slicer.view_manager, self.server)
+        self.layouts = LayoutManager(self.slicer.scene, self.slicer.view_manager, self.server)
+        self.layouts.register_layout_dict(LayoutManager.default_grid_configuration())
+        self.maximum_samples = maximum_samples
+
+        state = self.server.state
+        state.trame__title = "mmrtm-web"
+        state.presets = self.volume_rendering.preset_names()
+        state.preset = preset if preset in state.presets else (state.presets[0] if state.presets else "")
+        state.change("preset")(self.on_preset)
+
+        with SinglePageLayout(self.server) as self.ui:
+            self.ui.title.set_text("mmrtm-web: path tracing (MM-RTM)")
+            with self.ui.toolbar:
+                vuetify3.VSpacer()
+                vuetify3.VSelect(v_model=("preset",), items=("presets",), label="Preset", density="compact",
+                                 hide_details=True, style="max-width: 240px", classes="preset-select")
+            with self.ui.content:
+                with Div(classes="fill-height d-flex flex-row flex-grow-1"):
+                    self.layouts.initialize_layout_grid(self.ui)
+        self.layouts.set_layout("3D Primary")
+        self.volume = self.load(volume_path)
+
+    def load(self, path):
+        """Loads the study, shows it path traced and in the slice views."""
+        nodes = self.slicer.io_manager.load_volumes(volume_files(path))
+        if not nodes or nodes[0] is None:
+            raise ValueError("%s: Slicer's volumes reader could not read it" % path)
+        volume = nodes[0]
+        self.slicer.display_manager.show_volume(volume, vr_preset=self.server.state.preset, do_reset_views=True)
+        display = self.volume_rendering.get_vr_display_node(volume)
+        if display is None or not display.IsA(METHOD):
+            raise RuntimeError("Volume Rendering made a %s, not our display node"
+                               % (display.GetClassName() if display else "no node"))
+        display.SetAsynchronousRefinement(True)
+        display.SetMaximumSamples(self.maximum_samples)
+        return volume
+
+    def on_preset(self, preset, **_):
+        if getattr(self, "volume", None) is not None and preset:
+            self.volume_rendering.apply_preset(self.volume_rendering.get_vr_display_node(self.volume), preset)
+
+
+def main(argv=None):
+    args = parse_arguments(sys.argv[1:] if argv is None else argv)
+    # Without a display the PyPI VTK renders through EGL; say so up front
+    # instead of letting it warn.
+    if not os.environ.get("DISPLAY"):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    try:
+        import trame_slicer  # noqa: F401
+        import mmrtm_slicer  # noqa: F401
+    except ImportError as e:
+        sys.exit("mmrtm-web: %s: it needs trame-slicer and the mmrtm wheel built with its Slicer classes "
+                 "(pip install mmrtm[web]; Documentation/web.md)" % e)
+    if args.volume is None:
+        sys.exit("mmrtm-web: name a volume file or a DICOM folder (mmrtm-web --help)")
+    if not is_loopback(args.host):
+        print("mmrtm-web: warning: serving on %s, beyond this machine, with no authentication: put it behind a "
+              "reverse proxy that authenticates (Documentation/web.md)" % args.host, file=sys.stderr)
+    try:
+        viewer = WebViewer(args.volume, preset=args.preset, maximum_samples=args.maximum_samples)
+    except ValueError as e:
+        sys.exit("mmrtm-web: error: %s" % e)
+    viewer.server.start(host=args.host, port=args.port, open_browser=False)
+
+
+if __name__ == "__main__":
+    main()
