@@ -65,7 +65,7 @@ class WebViewer:
         self.slicer.register_module_logic(vtkSlicerMultiMaterialVolumeRenderingLogic(),
                                           logic_name="MultiMaterialVolumeRendering")
         self.volume_rendering = self.slicer.volume_rendering
-        self.volume_rendering._logic.SetDefaultRenderingMethod(METHOD)
+        self.slicer.app_logic.GetModuleLogic("VolumeRendering").SetDefaultRenderingMethod(METHOD)
         register_rca_factories(self.slicer.view_manager, self.server)
         self.layouts = LayoutManager(self.slicer.scene, self.slicer.view_manager, self.server)
         self.layouts.register_layout_dict(LayoutManager.default_grid_configuration())
