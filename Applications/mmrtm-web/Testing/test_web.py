@@ -10,12 +10,14 @@ import shutil
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 import unittest
 
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
 from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.keys import Keys
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 OUTPUT = os.environ.get("MMRTM_TEST_OUTPUT_DIR", os.getcwd())
@@ -64,9 +66,21 @@ class WebViewerTest(unittest.TestCase):
                                    "chromium and chromium-driver")
         os.makedirs(OUTPUT, exist_ok=True)
         cls.port = free_port()
+        # A data root of the test's own: two studies, a damaged file, and
+        # symbolic links that lead out of it.
+        cls.root = tempfile.TemporaryDirectory()
+        root = cls.root.name
+        for name in ("ct_head_cranium.nrrd", "ct_head_headsq.nrrd"):
+            shutil.copy(os.path.join(DATA, name), root)
+        with open(os.path.join(DATA, "ct_head_headsq.nrrd"), "rb") as f:
+            head = f.read()
+        with open(os.path.join(root, "damaged.nrrd"), "wb") as f:
+            f.write(head[: len(head) // 3])
+        os.symlink(os.path.join(DATA, "ct_head_headsq.nrrd"), os.path.join(root, "link_out.nrrd"))
+        os.symlink(os.path.join(DATA, "ct_chest_dicom"), os.path.join(root, "folder_out"))
         script = shutil.which("mmrtm-web", path=os.path.dirname(sys.executable))
         cls.log = open(os.path.join(OUTPUT, "mmrtm-web-test.log"), "w")
-        cls.server = subprocess.Popen([script, os.path.join(DATA, "ct_head_cranium.nrrd"), "--port", str(cls.port)],
+        cls.server = subprocess.Popen([script, os.path.join(root, "ct_head_cranium.nrrd"), "--port", str(cls.port)],
                                       stdout=cls.log, stderr=subprocess.STDOUT)
         options = Options()
         for argument in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1200,800"):
@@ -80,6 +94,7 @@ class WebViewerTest(unittest.TestCase):
         cls.server.terminate()
         cls.server.wait(timeout=30)
         cls.log.close()
+        cls.root.cleanup()
 
     def open_page(self):
         """Loads the page once the server answers (it loads the volume first)."""
@@ -106,7 +121,7 @@ class WebViewerTest(unittest.TestCase):
             time.sleep(0.1)
         self.fail("no 3D frame within %.0f s (last: %s)" % (timeout, statistics))
 
-    def test_the_page_shows_the_path_traced_head_and_a_preset_changes_it(self):
+    def test_a_the_page_shows_the_path_traced_head_and_a_preset_changes_it(self):
         """The first path-traced frame reaches the browser, shows the head
         (neither empty nor filled), and a preset chosen in the page changes
         the image. Catches a server that never streams our view, a 3D view
@@ -143,6 +158,39 @@ class WebViewerTest(unittest.TestCase):
         print("the preset's image %.2f s after the click: mean change %.1f levels (refinement alone: %.1f)"
               % (time.monotonic() - clicked, changed[4], refinement))
 
+
+    def open_study(self, path):
+        """Types `path` into the study field and presses Open; returns the
+        page's message once the server has answered (or "")."""
+        field = self.browser.find_element("css selector", ".study-path input")
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys(Keys.DELETE)
+        field.send_keys(path, Keys.ENTER)
+        time.sleep(0.5)
+        self.browser.find_element("css selector", ".open-study").click()
+        time.sleep(2)
+        messages = self.browser.find_elements("css selector", ".study-message")
+        return messages[0].text if messages else ""
+
+    def test_b_studies_open_from_the_data_root_only(self):
+        """Paths that lead out of the data root (`..`, a symbolic link to a
+        file or to a folder outside) are refused with a message in the page;
+        a damaged file gives a message and the server goes on; a study in
+        the root opens and changes the image. Catches a server that opens
+        any path it is sent, or dies on bad input."""
+        self.open_page()
+        self.frame(60, lambda s: 0.02 < s[2] < 0.95, keep=True)
+        for path, expected in (("../etc/passwd", "outside the data root"),
+                               ("link_out.nrrd", "outside the data root"),
+                               ("folder_out", "outside the data root"),
+                               ("damaged.nrrd", "could not read")):
+            message = self.open_study(path)
+            print("%s: %s" % (path, message))
+            self.assertIn(expected, message, path)
+            self.assertIsNone(self.server.poll(), "the server goes on after " + path)
+        self.assertEqual(self.open_study("ct_head_headsq.nrrd"), "", "a study in the data root opens")
+        changed = self.frame(30, lambda s: s[4] > 10)
+        print("the other study's image: mean change %.1f levels" % changed[4])
 
 if __name__ == "__main__":
     unittest.main()

@@ -1,10 +1,10 @@
 """mmrtm-web: a study path traced by MM-RTM in a browser, on trame-slicer.
 
-    mmrtm-web [VOLUME_OR_DICOM_FOLDER] [--host 127.0.0.1] [--port 8080]
+    mmrtm-web [VOLUME_OR_DICOM_FOLDER] [--data-root DIR] [--host 127.0.0.1] [--port 8080]
 
 Serves a page with Slicer's layouts (the 3D view path traced by our method,
-the axial, coronal and sagittal slices beside it) and Slicer's Volume
-Rendering presets. The 3D view refines in the background (the display
+the axial, coronal and sagittal slices beside it), Slicer's Volume
+Rendering presets, and the studies of the data root to open. The 3D view refines in the background (the display
 node's AsynchronousRefinement), so the server answers the browser between
 sample passes. Documentation/web.md says what it does and does not do yet.
 """
@@ -20,6 +20,8 @@ DEFAULT_PRESET = "CT-Bone"
 def parse_arguments(argv):
     parser = argparse.ArgumentParser(prog="mmrtm-web", description=__doc__.split("\n\n")[0])
     parser.add_argument("volume", nargs="?", help="a volume file (NRRD, NIfTI, MetaImage) or a DICOM folder")
+    parser.add_argument("--data-root", help="the folder the page may open studies from (default: the study's "
+                        "folder); paths that lead outside it are refused")
     parser.add_argument("--host", default="127.0.0.1", help="address to serve on (default: loopback only)")
     parser.add_argument("--port", type=int, default=8080, help="port (default 8080; 0: any free port)")
     parser.add_argument("--preset", default=DEFAULT_PRESET, help="Volume Rendering preset (default CT-Bone)")
@@ -33,10 +35,10 @@ def volume_files(path):
     if os.path.isdir(path):
         files = sorted(os.path.join(path, f) for f in os.listdir(path) if os.path.isfile(os.path.join(path, f)))
         if not files:
-            raise ValueError("%s: the folder holds no files" % path)
+            raise ValueError("the folder holds no files")
         return files
     if not os.path.isfile(path):
-        raise ValueError("%s: no such file or folder" % path)
+        raise ValueError("no such file or folder")
     return [path]
 
 
@@ -50,7 +52,7 @@ def is_loopback(host):
 class WebViewer:
     """The trame server, the Slicer core behind it, and the page."""
 
-    def __init__(self, volume_path, preset=DEFAULT_PRESET, maximum_samples=64, server=None):
+    def __init__(self, volume_path, data_root, preset=DEFAULT_PRESET, maximum_samples=64, server=None):
         from trame.app import get_server
         from trame.widgets import vuetify3
         from trame_client.widgets.html import Div
@@ -70,31 +72,59 @@ class WebViewer:
         self.layouts = LayoutManager(self.slicer.scene, self.slicer.view_manager, self.server)
         self.layouts.register_layout_dict(LayoutManager.default_grid_configuration())
         self.maximum_samples = maximum_samples
+        self.data_root = data_root
+        self.volume = None
 
         state = self.server.state
         state.trame__title = "mmrtm-web"
         state.presets = self.volume_rendering.preset_names()
         state.preset = preset if preset in state.presets else (state.presets[0] if state.presets else "")
         state.change("preset")(self.on_preset)
+        state.studies = data_root.studies()
+        state.study = ""
+        state.message = ""
+        self.server.controller.open_study = self.on_open_study
 
         with SinglePageLayout(self.server) as self.ui:
             self.ui.title.set_text("mmrtm-web: path tracing (MM-RTM)")
             with self.ui.toolbar:
                 vuetify3.VSpacer()
+                vuetify3.VCombobox(v_model=("study",), items=("studies",), label="Study (in the data root)",
+                                   density="compact", hide_details=True, style="max-width: 320px",
+                                   classes="study-path")
+                vuetify3.VBtn("Open", click=self.server.controller.open_study, classes="open-study")
                 vuetify3.VSelect(v_model=("preset",), items=("presets",), label="Preset", density="compact",
                                  hide_details=True, style="max-width: 240px", classes="preset-select")
             with self.ui.content:
+                vuetify3.VAlert(v_if=("message",), text=("message",), type="error", density="compact",
+                                closable=True, classes="study-message")
                 with Div(classes="fill-height d-flex flex-row flex-grow-1"):
                     self.layouts.initialize_layout_grid(self.ui)
         self.layouts.set_layout("3D Primary")
-        self.volume = self.load(volume_path)
+        path = data_root.resolve(volume_path)
+        try:
+            self.volume = self.load(path)
+        except ValueError as e:
+            raise ValueError("%s: %s" % (path, e)) from e
 
     def load(self, path):
-        """Loads the study, shows it path traced and in the slice views."""
-        nodes = self.slicer.io_manager.load_volumes(volume_files(path))
+        """Loads the study, shows it path traced and in the slice views, in
+        place of the one shown before. Raises ValueError saying why when
+        Slicer's reader cannot read it (the study shown stays); the caller
+        names the path, as the page knows it."""
+        files = volume_files(path)
+        try:
+            nodes = self.slicer.io_manager.load_volumes(files)
+        except Exception as e:  # Slicer's reader raises what it likes on damaged input
+            raise ValueError("Slicer's volumes reader could not read it (%s)" % type(e).__name__) from e
         if not nodes or nodes[0] is None:
-            raise ValueError("%s: Slicer's volumes reader could not read it" % path)
+            raise ValueError("Slicer's volumes reader could not read it (damaged, or not a volume)")
         volume = nodes[0]
+        if self.volume is not None:
+            shown = self.volume_rendering.get_vr_display_node(self.volume)
+            if shown is not None:
+                self.slicer.scene.RemoveNode(shown)
+            self.slicer.scene.RemoveNode(self.volume)
         self.slicer.display_manager.show_volume(volume, vr_preset=self.server.state.preset, do_reset_views=True)
         display = self.volume_rendering.get_vr_display_node(volume)
         if display is None or not display.IsA(METHOD):
@@ -103,6 +133,21 @@ class WebViewer:
         display.SetAsynchronousRefinement(True)
         display.SetMaximumSamples(self.maximum_samples)
         return volume
+
+    def on_open_study(self):
+        """The page's Open: the study typed or chosen, if the data root holds
+        it; otherwise a message in the page (the server goes on)."""
+        state = self.server.state
+        try:
+            path = self.data_root.resolve(state.study)
+        except ValueError as e:
+            state.message = str(e)
+            return
+        try:
+            self.volume = self.load(path)
+            state.message = ""
+        except ValueError as e:
+            state.message = "'%s': %s" % (state.study, e)
 
     def on_preset(self, preset, **_):
         if getattr(self, "volume", None) is not None and preset:
@@ -123,11 +168,17 @@ def main(argv=None):
                  "(pip install mmrtm[web]; Documentation/web.md)" % e)
     if args.volume is None:
         sys.exit("mmrtm-web: name a volume file or a DICOM folder (mmrtm-web --help)")
+    from .data_root import DataRoot
+    try:
+        root = DataRoot(args.data_root or os.path.dirname(os.path.abspath(args.volume.rstrip("/"))))
+    except ValueError as e:
+        sys.exit("mmrtm-web: error: %s" % e)
     if not is_loopback(args.host):
         print("mmrtm-web: warning: serving on %s, beyond this machine, with no authentication: put it behind a "
               "reverse proxy that authenticates (Documentation/web.md)" % args.host, file=sys.stderr)
     try:
-        viewer = WebViewer(args.volume, preset=args.preset, maximum_samples=args.maximum_samples)
+        viewer = WebViewer(os.path.abspath(args.volume), root, preset=args.preset,
+                           maximum_samples=args.maximum_samples)
     except ValueError as e:
         sys.exit("mmrtm-web: error: %s" % e)
     viewer.server.start(host=args.host, port=args.port, open_browser=False)
