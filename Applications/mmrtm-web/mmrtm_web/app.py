@@ -14,6 +14,8 @@ import os
 import sys
 
 METHOD = "vtkMRMLMultiMaterialVolumeRenderingDisplayNode"
+# The methods the page offers: ours, and Slicer's CPU ray cast to compare.
+METHODS = {"Path tracing (MM-RTM)": METHOD, "Slicer's CPU ray cast": "vtkMRMLCPURayCastVolumeRenderingDisplayNode"}
 DEFAULT_PRESET = "CT-Bone"
 
 
@@ -67,7 +69,8 @@ class WebViewer:
         self.slicer.register_module_logic(vtkSlicerMultiMaterialVolumeRenderingLogic(),
                                           logic_name="MultiMaterialVolumeRendering")
         self.volume_rendering = self.slicer.volume_rendering
-        self.slicer.app_logic.GetModuleLogic("VolumeRendering").SetDefaultRenderingMethod(METHOD)
+        self.volume_rendering_logic = self.slicer.app_logic.GetModuleLogic("VolumeRendering")
+        self.volume_rendering_logic.SetDefaultRenderingMethod(METHOD)
         register_rca_factories(self.slicer.view_manager, self.server)
         self.layouts = LayoutManager(self.slicer.scene, self.slicer.view_manager, self.server)
         self.layouts.register_layout_dict(LayoutManager.default_grid_configuration())
@@ -80,6 +83,9 @@ class WebViewer:
         state.presets = self.volume_rendering.preset_names()
         state.preset = preset if preset in state.presets else (state.presets[0] if state.presets else "")
         state.change("preset")(self.on_preset)
+        state.methods = list(METHODS)
+        state.method = state.methods[0]
+        state.change("method")(self.on_method)
         state.studies = data_root.studies()
         state.study = ""
         state.message = ""
@@ -95,6 +101,8 @@ class WebViewer:
                 vuetify3.VBtn("Open", click=self.server.controller.open_study, classes="open-study")
                 vuetify3.VSelect(v_model=("preset",), items=("presets",), label="Preset", density="compact",
                                  hide_details=True, style="max-width: 240px", classes="preset-select")
+                vuetify3.VSelect(v_model=("method",), items=("methods",), label="Rendering", density="compact",
+                                 hide_details=True, style="max-width: 240px", classes="method-select")
             with self.ui.content:
                 vuetify3.VAlert(v_if=("message",), text=("message",), type="error", density="compact",
                                 closable=True, classes="study-message")
@@ -126,13 +134,19 @@ class WebViewer:
                 self.slicer.scene.RemoveNode(shown)
             self.slicer.scene.RemoveNode(self.volume)
         self.slicer.display_manager.show_volume(volume, vr_preset=self.server.state.preset, do_reset_views=True)
-        display = self.volume_rendering.get_vr_display_node(volume)
-        if display is None or not display.IsA(METHOD):
-            raise RuntimeError("Volume Rendering made a %s, not our display node"
-                               % (display.GetClassName() if display else "no node"))
-        display.SetAsynchronousRefinement(True)
-        display.SetMaximumSamples(self.maximum_samples)
+        self.configure(self.volume_rendering.get_vr_display_node(volume))
         return volume
+
+    def configure(self, display):
+        """Our settings on a display node of the chosen method (Volume
+        Rendering makes a new node at each method change)."""
+        wanted = METHODS[self.server.state.method]
+        if display is None or not display.IsA(wanted):
+            raise RuntimeError("Volume Rendering made a %s, not a %s"
+                               % (display.GetClassName() if display else "no node", wanted))
+        if display.IsA(METHOD):
+            display.SetAsynchronousRefinement(True)
+            display.SetMaximumSamples(self.maximum_samples)
 
     def on_open_study(self):
         """The page's Open: the study typed or chosen, if the data root holds
@@ -148,6 +162,14 @@ class WebViewer:
             state.message = ""
         except ValueError as e:
             state.message = "'%s': %s" % (state.study, e)
+
+    def on_method(self, method, **_):
+        if method not in METHODS:
+            return
+        self.volume_rendering_logic.SetDefaultRenderingMethod(METHODS[method])
+        if self.volume is not None:
+            self.volume_rendering_logic.ChangeVolumeRenderingMethod(METHODS[method])
+            self.configure(self.volume_rendering.get_vr_display_node(self.volume))
 
     def on_preset(self, preset, **_):
         if getattr(self, "volume", None) is not None and preset:
