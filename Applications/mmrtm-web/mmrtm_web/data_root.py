@@ -16,7 +16,7 @@ class DataRoot:
         """The real path of `path` (relative to the root, or absolute).
         Raises ValueError, naming the path, when it leads outside the root
         or to nothing."""
-        if not path or not path.strip():
+        if not isinstance(path, str) or not path.strip():  # the page's state may hold anything
             raise ValueError("no study named")
         real = os.path.realpath(os.path.join(self.folder, path.strip()))
         if os.path.commonpath([real, self.folder]) != self.folder:
