@@ -205,18 +205,32 @@ class WebViewerTest(unittest.TestCase):
               % (time.monotonic() - clicked, changed[4], refinement))
 
 
+    def message(self):
+        messages = self.browser.find_elements("css selector", ".study-message")
+        return messages[0].text if messages else ""
+
     def open_study(self, path):
         """Types `path` into the study field and presses Open; returns the
-        page's message once the server has answered (or "")."""
+        page's message once the server has answered: a new message (each
+        path's names it, so consecutive ones differ), or "" once the page
+        says it shows `path`."""
+        before = self.message()
+        shown = self.browser.find_element("css selector", ".shown-study")
         field = self.browser.find_element("css selector", ".study-path input")
         field.send_keys(Keys.CONTROL, "a")
         field.send_keys(Keys.DELETE)
         field.send_keys(path, Keys.ENTER)
         time.sleep(0.5)
         self.browser.find_element("css selector", ".open-study").click()
-        time.sleep(2)
-        messages = self.browser.find_elements("css selector", ".study-message")
-        return messages[0].text if messages else ""
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            time.sleep(0.25)
+            now = self.message()
+            if now != before and now:
+                return now
+            if not now and shown.text.strip() == path:
+                return ""
+        return self.message() or "no answer: the page shows %r" % shown.text
 
     def test_b_studies_open_from_the_data_root_only(self):
         """Paths that lead out of the data root (`..`, a symbolic link to a

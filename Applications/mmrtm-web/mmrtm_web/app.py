@@ -57,6 +57,7 @@ class WebViewer:
     def __init__(self, volume_path, data_root, preset=DEFAULT_PRESET, maximum_samples=64, server=None):
         from trame.app import get_server
         from trame.widgets import vuetify3
+        from trame_client.widgets import html
         from trame_client.widgets.html import Div
         from trame_slicer.core import LayoutManager, SlicerApp
         from trame_slicer.rca_view import register_rca_factories
@@ -88,6 +89,7 @@ class WebViewer:
         state.change("method")(self.on_method)
         state.studies = data_root.studies()
         state.study = ""
+        state.shown = ""  # the study shown, as the data root names it
         state.message = ""
         self.server.controller.open_study = self.on_open_study
 
@@ -95,6 +97,7 @@ class WebViewer:
             self.ui.title.set_text("mmrtm-web: path tracing (MM-RTM)")
             with self.ui.toolbar:
                 vuetify3.VSpacer()
+                html.Span("{{ shown }}", classes="shown-study text-body-2 mr-4")
                 vuetify3.VCombobox(v_model=("study",), items=("studies",), label="Study (in the data root)",
                                    density="compact", hide_details=True, style="max-width: 320px",
                                    classes="study-path")
@@ -114,6 +117,7 @@ class WebViewer:
             self.volume = self.load(path)
         except ValueError as e:
             raise ValueError("%s: %s" % (path, e)) from e
+        state.shown = os.path.relpath(path, data_root.folder)
 
     def load(self, path):
         """Loads the study, shows it path traced and in the slice views, in
@@ -160,6 +164,7 @@ class WebViewer:
         try:
             self.volume = self.load(path)
             state.message = ""
+            state.shown = state.study
         except ValueError as e:
             state.message = "'%s': %s" % (state.study, e)
 
