@@ -481,29 +481,49 @@ TEST(VolumeLoader, NanVoxelIsTheLeastValueAndInfinityIsRejected) {
   ExpectInputError(path, "non-finite");
 }
 
-// A NRRD of the values 0, 1, 2, ... (mod the type's span, signed types
-// negative in part) as `encoding` (raw or gzip) in `endian` byte order, its
-// data attached or in a detached file. Returns the header's path.
-std::string WriteNrrdOfType(const std::string& name, const std::string& type, int size, const std::string& encoding,
-                            const std::string& endian, bool detached) {
-  const std::string path = Scratch(name + (detached ? ".nhdr" : ".nrrd"));
-  const int nx = 37, ny = 11, nz = 5;
-  std::vector<uint8_t> bytes((size_t)nx * ny * nz * size);
-  for (int i = 0; i < nx * ny * nz; ++i) {
+// The voxel types the loaders read in place, as NRRD and MetaImage name them.
+struct NativeType {
+  const char* nrrd;
+  const char* metaImage;
+  int size;
+  VoxelType voxelType;
+};
+constexpr NativeType kNativeTypes[] = {{"uchar", "MET_UCHAR", 1, VoxelType::UInt8},
+                                       {"short", "MET_SHORT", 2, VoxelType::Int16},
+                                       {"ushort", "MET_USHORT", 2, VoxelType::UInt16},
+                                       {"float", "MET_FLOAT", 4, VoxelType::Float32}};
+constexpr int kRampDims[3] = {37, 11, 5};
+
+// The bytes of a 37 x 11 x 5 ramp 0, 1, 2, ... of `type` (mod its span;
+// int16 shifted by -1000, float as 0.25 i - 100), in big or little endian.
+std::vector<uint8_t> RampBytes(const NativeType& type, bool bigEndian) {
+  const int n = kRampDims[0] * kRampDims[1] * kRampDims[2], size = type.size;
+  std::vector<uint8_t> bytes((size_t)n * size);
+  for (int i = 0; i < n; ++i) {
     uint8_t* v = bytes.data() + (size_t)i * size;
-    if (type == "float") {
+    if (type.voxelType == VoxelType::Float32) {
       const float f = 0.25f * (float)i - 100.f;
       std::memcpy(v, &f, 4);
     } else {
-      const int value = type == "short" ? i - 1000 : i;
+      const int value = type.voxelType == VoxelType::Int16 ? i - 1000 : i;
       std::memcpy(v, &value, (size_t)size);  // little endian, as this machine is
     }
-    if (endian == "big") std::reverse(v, v + size);
+    if (bigEndian) std::reverse(v, v + size);
   }
+  return bytes;
+}
+
+// A NRRD of RampBytes as `encoding` (raw or gzip) in `endian` byte order,
+// its data attached or in a detached file. Returns the header's path.
+std::string WriteNrrdOfType(const std::string& name, const NativeType& type, const std::string& encoding,
+                            const std::string& endian, bool detached) {
+  const std::string path = Scratch(name + (detached ? ".nhdr" : ".nrrd"));
+  const int nx = kRampDims[0], ny = kRampDims[1], nz = kRampDims[2];
+  const std::vector<uint8_t> bytes = RampBytes(type, endian == "big");
   const std::string dataName = name + (encoding == "gzip" ? ".raw.gz" : ".raw");
   {
     std::ofstream out(path, std::ios::binary);
-    out << "NRRD0004\ntype: " << type << "\ndimension: 3\nsizes: " << nx << " " << ny << " " << nz
+    out << "NRRD0004\ntype: " << type.nrrd << "\ndimension: 3\nsizes: " << nx << " " << ny << " " << nz
         << "\nspacings: 1 1 1\nencoding: " << encoding << "\nendian: " << endian << "\n";
     if (detached) out << "data file: " << dataName << "\n";
     out << "\n";
@@ -527,20 +547,14 @@ std::string WriteNrrdOfType(const std::string& name, const std::string& type, in
 // detached), bytes not swapped from big endian, and a row order that
 // differs from vtkNrrdReader's (which reverses rows and has them put back).
 TEST(VolumeLoader, RawNrrdReadDirectlyEqualsTheVtkReadersVoxels) {
-  struct Type {
-    const char* name;
-    int size;
-    VoxelType voxelType;
-  };
-  for (const Type& t : {Type{"uchar", 1, VoxelType::UInt8}, Type{"short", 2, VoxelType::Int16},
-                        Type{"ushort", 2, VoxelType::UInt16}, Type{"float", 4, VoxelType::Float32}}) {
-    SCOPED_TRACE(t.name);
-    const HostVolume reference = LoadVolume(WriteNrrdOfType("gz", t.name, t.size, "gzip", "little", false));
+  for (const NativeType& t : kNativeTypes) {
+    SCOPED_TRACE(t.nrrd);
+    const HostVolume reference = LoadVolume(WriteNrrdOfType("gz", t, "gzip", "little", false));
     ASSERT_EQ(reference.type, t.voxelType);
     for (const char* endian : {"little", "big"})
       for (bool detached : {false, true}) {
         SCOPED_TRACE(std::string(endian) + (detached ? " detached" : " attached"));
-        const HostVolume v = LoadVolume(WriteNrrdOfType("raw", t.name, t.size, "raw", endian, detached));
+        const HostVolume v = LoadVolume(WriteNrrdOfType("raw", t, "raw", endian, detached));
         EXPECT_EQ(v.type, t.voxelType);
         EXPECT_EQ(v.dims, reference.dims);
         EXPECT_TRUE(v.voxels == reference.voxels);
@@ -548,24 +562,13 @@ TEST(VolumeLoader, RawNrrdReadDirectlyEqualsTheVtkReadersVoxels) {
   }
 }
 
-// A MetaImage of the values of WriteNrrdOfType's volume: uncompressed
-// (LOCAL in a .mha, or a detached .raw) in `order` (MSB: big endian), or
-// zlib-compressed (read by vtkMetaImageReader). Returns the header's path.
-std::string WriteMetaImageOfType(const std::string& name, const std::string& type, int size, bool compressed, bool msb,
+// A MetaImage of RampBytes: uncompressed (LOCAL in a .mha, or a detached
+// .raw) in big endian when `msb`, or zlib-compressed (read by
+// vtkMetaImageReader). Returns the header's path.
+std::string WriteMetaImageOfType(const std::string& name, const NativeType& type, bool compressed, bool msb,
                                  bool detached) {
-  const int nx = 37, ny = 11, nz = 5;
-  std::vector<uint8_t> bytes((size_t)nx * ny * nz * size);
-  for (int i = 0; i < nx * ny * nz; ++i) {
-    uint8_t* v = bytes.data() + (size_t)i * size;
-    if (type == "MET_FLOAT") {
-      const float f = 0.25f * (float)i - 100.f;
-      std::memcpy(v, &f, 4);
-    } else {
-      const int value = type == "MET_SHORT" ? i - 1000 : i;
-      std::memcpy(v, &value, (size_t)size);
-    }
-    if (msb) std::reverse(v, v + size);
-  }
+  const int nx = kRampDims[0], ny = kRampDims[1], nz = kRampDims[2];
+  const std::vector<uint8_t> bytes = RampBytes(type, msb);
   std::vector<uint8_t> data = bytes;
   if (compressed) {
     uLongf length = compressBound((uLong)bytes.size());
@@ -580,7 +583,7 @@ std::string WriteMetaImageOfType(const std::string& name, const std::string& typ
       << "\nCompressedData = " << (compressed ? "True" : "False") << "\n";
   if (compressed) out << "CompressedDataSize = " << data.size() << "\n";
   out << "ElementSpacing = 0.5 0.75 2\nOffset = 10 20 30\nDimSize = " << nx << " " << ny << " " << nz
-      << "\nElementType = " << type << "\nElementDataFile = " << (detached ? dataName : "LOCAL") << "\n";
+      << "\nElementType = " << type.metaImage << "\nElementDataFile = " << (detached ? dataName : "LOCAL") << "\n";
   if (detached) {
     out.close();
     std::ofstream((fs::path(path).parent_path() / dataName).string(), std::ios::binary)
@@ -597,20 +600,14 @@ std::string WriteMetaImageOfType(const std::string& name, const std::string& typ
 // the header, or a detached file), bytes not swapped from big endian, and
 // geometry that came from VTK's image before.
 TEST(VolumeLoader, RawMetaImageReadDirectlyEqualsTheVtkReadersVoxels) {
-  struct Type {
-    const char* name;
-    int size;
-    VoxelType voxelType;
-  };
-  for (const Type& t : {Type{"MET_UCHAR", 1, VoxelType::UInt8}, Type{"MET_SHORT", 2, VoxelType::Int16},
-                        Type{"MET_USHORT", 2, VoxelType::UInt16}, Type{"MET_FLOAT", 4, VoxelType::Float32}}) {
-    SCOPED_TRACE(t.name);
-    const HostVolume reference = LoadVolume(WriteMetaImageOfType("z", t.name, t.size, true, false, true));
+  for (const NativeType& t : kNativeTypes) {
+    SCOPED_TRACE(t.metaImage);
+    const HostVolume reference = LoadVolume(WriteMetaImageOfType("z", t, true, false, true));
     ASSERT_EQ(reference.type, t.voxelType);
     for (bool msb : {false, true})
       for (bool detached : {false, true}) {
         SCOPED_TRACE(std::string(msb ? "MSB" : "LSB") + (detached ? " detached" : " LOCAL"));
-        const HostVolume v = LoadVolume(WriteMetaImageOfType("raw", t.name, t.size, false, msb, detached));
+        const HostVolume v = LoadVolume(WriteMetaImageOfType("raw", t, false, msb, detached));
         EXPECT_EQ(v.type, t.voxelType);
         EXPECT_EQ(v.dims, reference.dims);
         EXPECT_TRUE(v.voxels == reference.voxels);
@@ -623,11 +620,11 @@ TEST(VolumeLoader, RawMetaImageReadDirectlyEqualsTheVtkReadersVoxels) {
 // A raw data file shorter than its header's sizes, and a gzip stream cut
 // short: errors that name the file, no volume.
 TEST(VolumeLoader, ShortRawDataFileAndTruncatedGzipStreamAreErrors) {
-  const std::string detached = WriteNrrdOfType("short_detached", "short", 2, "raw", "little", true);
+  const std::string detached = WriteNrrdOfType("short_detached", kNativeTypes[1], "raw", "little", true);
   const std::string data = (fs::path(detached).parent_path() / "short_detached.raw").string();
   fs::resize_file(data, fs::file_size(data) - 2);
   ExpectInputError(detached, "short_detached.raw");
-  const std::string gz = WriteNrrdOfType("cut_gzip", "short", 2, "gzip", "little", false);
+  const std::string gz = WriteNrrdOfType("cut_gzip", kNativeTypes[1], "gzip", "little", false);
   fs::resize_file(gz, fs::file_size(gz) - 40);
   ExpectInputError(gz);
 }
@@ -640,7 +637,7 @@ TEST(VolumeLoader, LoadingReportsProgressUpToOne) {
     std::vector<double> fractions;
     mmrtm::VolumeLoadOptions options;
     options.progress = [&](double f) { fractions.push_back(f); };
-    LoadVolume(WriteNrrdOfType("progress", "short", 2, encoding, "little", false), "scalars", options);
+    LoadVolume(WriteNrrdOfType("progress", kNativeTypes[1], encoding, "little", false), "scalars", options);
     ASSERT_FALSE(fractions.empty());
     EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
     EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
