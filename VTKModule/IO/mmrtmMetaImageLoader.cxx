@@ -293,6 +293,13 @@ void CheckMetaImageDeclaredSize(const std::string& path, const MetaImageHeader& 
   }
 }
 
+// Whether the header says its binary data is big endian (either key).
+bool MetaImageBigEndian(const MetaImageHeader& h)
+{
+  return ToLower(Field(h, "BinaryDataByteOrderMSB") + Field(h, "ElementByteOrderMSB")).find("true") !=
+    std::string::npos;
+}
+
 // metaio reports a short or damaged data file only on the console and
 // returns what it read, so check that all `bytes` of voxel data (the
 // reader's buffer `voxels`) are there.
@@ -319,8 +326,7 @@ void CheckMetaImageData(const std::string& path, const MetaImageHeader& h, uint8
     if (inflated < bytes)
       throw InputError(path + ": voxel data is " + std::to_string(inflated) + " bytes, expected " +
         std::to_string(bytes) + " (truncated?)");
-    const std::string msb = ToLower(field("BinaryDataByteOrderMSB") + field("ElementByteOrderMSB"));
-    if (msb.find("true") != std::string::npos && valueSize > 1) // stored big endian; this machine is little endian
+    if (MetaImageBigEndian(h) && valueSize > 1) // stored big endian; this machine is little endian
       for (uint64_t i = 0; i + valueSize <= bytes; i += valueSize)
         std::reverse(voxels + i, voxels + i + valueSize);
     Warn(options,
@@ -395,9 +401,7 @@ void LoadMetaImage(const std::string& path, HostVolume& out, const VolumeLoadOpt
     raw.offset = data->offset;
     raw.count = out.VoxelCount();
     raw.type = *native;
-    raw.bigEndian =
-      ToLower(Field(header, "BinaryDataByteOrderMSB") + Field(header, "ElementByteOrderMSB")).find("true") !=
-      std::string::npos;
+    raw.bigEndian = MetaImageBigEndian(header);
     ReadRawVoxels(raw, out, options);
   }
   else

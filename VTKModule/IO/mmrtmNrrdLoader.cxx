@@ -64,39 +64,36 @@ struct NrrdHeader
   bool vtkFirstSpacingZero = false; // its guess of a vector axis also looks at this
 };
 
-// Bytes per value of a NRRD `type` (teem's names and aliases); 0 if unknown
-// (vtkNrrdReader then names the problem).
-int NrrdTypeSize(const std::string& type)
+// A NRRD `type` (teem's names and aliases): its bytes per value and the
+// type of the stored values.
+struct NrrdType
 {
-  static const std::pair<const char*, int> kTypes[] = { { "uchar", 1 }, { "unsigned char", 1 }, { "uint8", 1 },
-    { "uint8_t", 1 }, { "signed char", 1 }, { "int8", 1 }, { "int8_t", 1 }, { "char", 1 }, { "short", 2 },
-    { "short int", 2 }, { "signed short", 2 }, { "signed short int", 2 }, { "int16", 2 }, { "int16_t", 2 },
-    { "ushort", 2 }, { "unsigned short", 2 }, { "unsigned short int", 2 }, { "uint16", 2 }, { "uint16_t", 2 },
-    { "int", 4 }, { "signed int", 4 }, { "int32", 4 }, { "int32_t", 4 }, { "uint", 4 }, { "unsigned int", 4 },
-    { "uint32", 4 }, { "uint32_t", 4 }, { "longlong", 8 }, { "long long", 8 }, { "long long int", 8 },
-    { "signed long long", 8 }, { "signed long long int", 8 }, { "int64", 8 }, { "int64_t", 8 }, { "ulonglong", 8 },
-    { "unsigned long long", 8 }, { "unsigned long long int", 8 }, { "uint64", 8 }, { "uint64_t", 8 }, { "float", 4 },
-    { "double", 8 } };
-  for (const auto& [name, size] : kTypes)
-    if (type == name)
-      return size;
-  return 0;
-}
+  int size;
+  SourceType source;
+};
 
-// The voxel type of a NRRD `type` the tracer samples as it is; nullopt for
-// the others (converted by StoreVoxels).
-std::optional<VoxelType> NrrdNativeType(const std::string& type)
+// nullopt for a name teem does not know (vtkNrrdReader then names the problem).
+std::optional<NrrdType> FindNrrdType(const std::string& type)
 {
-  static const std::pair<const char*, VoxelType> kTypes[] = { { "uchar", VoxelType::UInt8 },
-    { "unsigned char", VoxelType::UInt8 }, { "uint8", VoxelType::UInt8 }, { "uint8_t", VoxelType::UInt8 },
-    { "short", VoxelType::Int16 }, { "short int", VoxelType::Int16 }, { "signed short", VoxelType::Int16 },
-    { "signed short int", VoxelType::Int16 }, { "int16", VoxelType::Int16 }, { "int16_t", VoxelType::Int16 },
-    { "ushort", VoxelType::UInt16 }, { "unsigned short", VoxelType::UInt16 },
-    { "unsigned short int", VoxelType::UInt16 }, { "uint16", VoxelType::UInt16 }, { "uint16_t", VoxelType::UInt16 },
-    { "float", VoxelType::Float32 } };
-  for (const auto& [name, voxelType] : kTypes)
+  using S = SourceType;
+  static const std::pair<const char*, NrrdType> kTypes[] = { { "uchar", { 1, S::UInt8 } },
+    { "unsigned char", { 1, S::UInt8 } }, { "uint8", { 1, S::UInt8 } }, { "uint8_t", { 1, S::UInt8 } },
+    { "signed char", { 1, S::Int8 } }, { "int8", { 1, S::Int8 } }, { "int8_t", { 1, S::Int8 } },
+    { "char", { 1, S::Int8 } }, { "short", { 2, S::Int16 } }, { "short int", { 2, S::Int16 } },
+    { "signed short", { 2, S::Int16 } }, { "signed short int", { 2, S::Int16 } }, { "int16", { 2, S::Int16 } },
+    { "int16_t", { 2, S::Int16 } }, { "ushort", { 2, S::UInt16 } }, { "unsigned short", { 2, S::UInt16 } },
+    { "unsigned short int", { 2, S::UInt16 } }, { "uint16", { 2, S::UInt16 } }, { "uint16_t", { 2, S::UInt16 } },
+    { "int", { 4, S::Int32 } }, { "signed int", { 4, S::Int32 } }, { "int32", { 4, S::Int32 } },
+    { "int32_t", { 4, S::Int32 } }, { "uint", { 4, S::UInt32 } }, { "unsigned int", { 4, S::UInt32 } },
+    { "uint32", { 4, S::UInt32 } }, { "uint32_t", { 4, S::UInt32 } }, { "longlong", { 8, S::Int64 } },
+    { "long long", { 8, S::Int64 } }, { "long long int", { 8, S::Int64 } }, { "signed long long", { 8, S::Int64 } },
+    { "signed long long int", { 8, S::Int64 } }, { "int64", { 8, S::Int64 } }, { "int64_t", { 8, S::Int64 } },
+    { "ulonglong", { 8, S::UInt64 } }, { "unsigned long long", { 8, S::UInt64 } },
+    { "unsigned long long int", { 8, S::UInt64 } }, { "uint64", { 8, S::UInt64 } }, { "uint64_t", { 8, S::UInt64 } },
+    { "float", { 4, S::Float32 } }, { "double", { 8, S::Float64 } } };
+  for (const auto& [name, t] : kTypes)
     if (type == name)
-      return voxelType;
+      return t;
   return std::nullopt;
 }
 
@@ -245,8 +242,11 @@ NrrdHeader ParseNrrdHeader(const std::string& path)
     }
     else if (field == "type")
     {
-      h.typeSize = NrrdTypeSize(ToLower(value));
-      h.nativeType = NrrdNativeType(ToLower(value));
+      if (const std::optional<NrrdType> t = FindNrrdType(ToLower(value)))
+      {
+        h.typeSize = t->size;
+        h.nativeType = NativeVoxelType(t->source);
+      }
     }
     else if (field == "endian")
     {
