@@ -6,6 +6,7 @@ classes and trame-slicer installed there), MMRTM_SHARED_DATA_DIR set, and
 MMRTM_TEST_OUTPUT_DIR for the screenshot (Documentation/web.md shows it).
 """
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -17,11 +18,14 @@ import unittest
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
 from selenium.webdriver.chrome.service import Service
+from selenium.common.exceptions import StaleElementReferenceException
+from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.keys import Keys
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 OUTPUT = os.environ.get("MMRTM_TEST_OUTPUT_DIR", os.getcwd())
 CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+MAXIMUM_SAMPLES, SAMPLES_PER_PASS = 32, 4  # the server's --maximum-samples; the display node's default
 
 # The 3D view's frame: the largest streamed <img>, drawn into a canvas to
 # read its pixels. The background is a vertical gradient, so a pixel is the
@@ -88,6 +92,45 @@ return w + 'x' + h + ':' + bits.join('');
 """
 
 
+# Of the pixels that changed (by over 30 levels) since the kept frame: the
+# fraction that lie on the kept frame's volume, and their number over the
+# kept frame's volume pixels; [-1, 0] if none changed.
+CHANGE_ON_THE_VOLUME = """
+const images = Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
+const img = images.reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b);
+const canvas = document.createElement('canvas');
+const w = img.naturalWidth, h = img.naturalHeight;
+canvas.width = w; canvas.height = h;
+canvas.getContext('2d').drawImage(img, 0, 0);
+const p = canvas.getContext('2d').getImageData(0, 0, w, h).data;
+const kept = window.mmrtmKeptFrame, keptMask = window.mmrtmKeptMask;
+if (!kept || kept.length !== p.length) return -1;
+let changed = 0, onVolume = 0, volume = 0;
+for (let i = 0; i < w * h; i++) {
+  const d = Math.abs(p[4 * i] - kept[4 * i]) + Math.abs(p[4 * i + 1] - kept[4 * i + 1]) + Math.abs(p[4 * i + 2] - kept[4 * i + 2]);
+  volume += keptMask[i];
+  if (d > 30) { changed++; onVolume += keptMask[i]; }
+}
+return changed ? [onVolume / changed, changed / Math.max(volume, 1)] : [-1, 0];
+"""
+
+# Records, in the page, when each streamed frame arrived (its size) and
+# when the mouse went down, moved with a button held, and went up.
+RECORDER = """
+if (window.mmrtmLoads) return;
+window.mmrtmLoads = []; window.mmrtmMouse = [];
+const observe = () => { for (const img of document.querySelectorAll('img')) {
+  if (img.mmrtmObserved) continue;
+  img.mmrtmObserved = true;
+  img.addEventListener('load', () => window.mmrtmLoads.push([performance.now(), img.naturalWidth * img.naturalHeight]));
+} };
+observe(); setInterval(observe, 100);
+document.addEventListener('mousedown', () => window.mmrtmMouse.push(['down', performance.now()]), true);
+document.addEventListener('mousemove', e => { if (e.buttons) window.mmrtmMouse.push(['move', performance.now()]); }, true);
+document.addEventListener('mouseup', () => window.mmrtmMouse.push(['up', performance.now()]), true);
+"""
+
+
 def intersection_over_union(a, b):
     if a.split(":")[0] != b.split(":")[0]:
         return -1.0
@@ -126,12 +169,30 @@ class WebViewerTest(unittest.TestCase):
         os.symlink(os.path.join(DATA, "ct_chest_dicom"), os.path.join(root, "folder_out"))
         script = shutil.which("mmrtm-web", path=os.path.dirname(sys.executable))
         cls.log = open(os.path.join(OUTPUT, "mmrtm-web-test.log"), "w")
-        cls.server = subprocess.Popen([script, os.path.join(root, "ct_head_cranium.nrrd"), "--port", str(cls.port)],
+        for name in ("mr_head.nii.gz", "cta_chest_aorta.nii.gz", "cta_chest_aorta_labels.nii.gz",
+                     "cta_chest_aorta_labels.txt"):
+            shutil.copy(os.path.join(DATA, name), root)
+        # A DICOM folder of two series (the chest CT and the abdomen CT).
+        os.mkdir(os.path.join(root, "two_series"))
+        for folder in ("ct_chest_dicom", "ct_abdomen_dicom_j2k"):
+            for name in os.listdir(os.path.join(DATA, folder)):
+                shutil.copy(os.path.join(DATA, folder, name), os.path.join(root, "two_series", folder + "_" + name))
+        cls.uploads = tempfile.TemporaryDirectory()
+        shutil.copy(os.path.join(DATA, "mr_head.nii.gz"), cls.uploads.name)
+        with open(os.path.join(cls.uploads.name, "damaged.nrrd"), "wb") as f:
+            f.write(head[: len(head) // 3])
+        shutil.copy(os.path.join(DATA, "ct_head_cranium.nrrd"), os.path.join(cls.uploads.name, "too_large.nrrd"))
+        cls.downloads = tempfile.TemporaryDirectory()
+        # Refinement to 32 samples keeps the test short; uploads up to 6 MiB
+        # let the MR head (3.2 MiB) in and keep the CT head (7.2 MiB) out.
+        cls.server = subprocess.Popen([script, os.path.join(root, "ct_head_cranium.nrrd"), "--port", str(cls.port),
+                                       "--maximum-samples", str(MAXIMUM_SAMPLES), "--upload-limit-mb", "6"],
                                       stdout=cls.log, stderr=subprocess.STDOUT)
         options = Options()
         for argument in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1200,800"):
             options.add_argument(argument)
         options.binary_location = CHROMIUM
+        options.add_experimental_option("prefs", {"download.default_directory": cls.downloads.name})
         cls.browser = webdriver.Chrome(service=Service(DRIVER), options=options)
 
     @classmethod
@@ -141,6 +202,8 @@ class WebViewerTest(unittest.TestCase):
         cls.server.wait(timeout=30)
         cls.log.close()
         cls.root.cleanup()
+        cls.uploads.cleanup()
+        cls.downloads.cleanup()
 
     def open_page(self):
         """Loads the page once the server answers (it loads the volume first)."""
@@ -154,6 +217,7 @@ class WebViewerTest(unittest.TestCase):
                 time.sleep(0.25)
         start = time.monotonic()
         self.browser.get("http://127.0.0.1:%d/" % self.port)
+        self.browser.execute_script(RECORDER)
         return start
 
     def frame(self, timeout, accept=lambda s: True, keep=False):
@@ -205,6 +269,22 @@ class WebViewerTest(unittest.TestCase):
               % (time.monotonic() - clicked, changed[4], refinement))
 
 
+    def enter_path(self, field_class, path):
+        """Types `path` into a path field, then leaves it (a click on the
+        title), which commits it and closes its list."""
+        field = self.browser.find_element("css selector", field_class + " input")
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys(Keys.DELETE)
+        field.send_keys(path)
+        time.sleep(0.3)
+        self.browser.find_element("css selector", ".v-toolbar-title").click()
+        time.sleep(0.5)
+        self.assertEqual(field.get_attribute("value"), path)
+
+    def click(self, selector):
+        """Clicks a button that the study field's open list may cover."""
+        self.browser.execute_script("arguments[0].click()", self.browser.find_element("css selector", selector))
+
     def message(self):
         messages = self.browser.find_elements("css selector", ".study-message")
         return messages[0].text if messages else ""
@@ -216,12 +296,8 @@ class WebViewerTest(unittest.TestCase):
         says it shows `path`."""
         before = self.message()
         shown = self.browser.find_element("css selector", ".shown-study")
-        field = self.browser.find_element("css selector", ".study-path input")
-        field.send_keys(Keys.CONTROL, "a")
-        field.send_keys(Keys.DELETE)
-        field.send_keys(path, Keys.ENTER)
-        time.sleep(0.5)
-        self.browser.find_element("css selector", ".open-study").click()
+        self.enter_path(".study-path", path)
+        self.click(".open-study")
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
             time.sleep(0.25)
@@ -257,10 +333,14 @@ class WebViewerTest(unittest.TestCase):
         self.browser.find_element("css selector", "." + select_class + " .v-field").click()
         deadline = time.monotonic() + 10
         while time.monotonic() < deadline:
-            items = [i for i in self.browser.find_elements("css selector", ".v-list-item") if i.text.strip() == item]
-            if items:
-                items[0].click()
-                return
+            try:
+                items = [i for i in self.browser.find_elements("css selector", ".v-list-item")
+                         if i.text.strip() == item]
+                if items:
+                    items[0].click()
+                    return
+            except StaleElementReferenceException:
+                pass  # another list (the study field's) closed meanwhile
             time.sleep(0.2)
         self.fail("no item %s in %s" % (item, select_class))
 
@@ -303,6 +383,216 @@ class WebViewerTest(unittest.TestCase):
         iou_back = intersection_over_union(ours_mask, self.browser.execute_script(FRAME_MASK))
         print("path traced again: coverage %.3f, brightness %.1f, IoU with the first %.3f" % (back[2], back[3], iou_back))
         self.assertGreater(iou_back, 0.95, "the same silhouette after switching back")
+
+    # Refinement, streaming and interaction.
+
+    def status(self):
+        """(samples, maximum samples, converged) as the toolbar says them."""
+        text = self.browser.find_element("css selector", ".refinement-status").text
+        match = re.match(r"(\d+) / (\d+) samples, noise [\d.]+ % \((\w+)\)", text)
+        self.assertTrue(match, "the toolbar's refinement state: %r" % text)
+        return int(match[1]), int(match[2]), match[3] == "converged"
+
+    def frames_rendered(self):
+        return int(self.browser.find_element("css selector", ".frame-count").get_attribute("textContent"))
+
+    def view_loads(self):
+        """Arrival times (ms) of the 3D view's frames: the largest frames."""
+        loads = self.browser.execute_script("return window.mmrtmLoads")
+        largest = max((area for _, area in loads), default=0)
+        return [t for t, area in loads if area == largest]
+
+    def wait_converged(self, frames_before=None, timeout=120):
+        """Waits for the toolbar to say converged at its maximum samples
+        (after a frame beyond `frames_before`, when given)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if frames_before is None or self.frames_rendered() > frames_before:
+                samples, maximum, converged = self.status()
+                if converged and samples >= maximum:
+                    return
+            time.sleep(0.1)
+        self.fail("not converged within %.0f s: %s" % (timeout, self.status()))
+
+    def test_d_refinement_streams_a_frame_a_pass_and_a_drag_previews_at_once(self):
+        """A restart refines to the maximum samples with one frame rendered
+        and received per sample pass (not several, as trame-rca's own
+        scheduler pushed); a camera drag shows its first preview within
+        0.2 s of the first move and at least 5 frames a second, and after
+        the release the image converges again, rotated. Catches a
+        scheduler that renders and pushes each pass several times, one
+        that misses passes, a render loop that blocks the server during
+        refinement (the drag would wait for it), and previews that are
+        too slow to follow the mouse."""
+        self.open_page()
+        self.frame(60)
+        self.assertEqual(self.open_study("ct_head_cranium.nrrd"), "")
+        self.choose("preset-select", "CT-Bone")
+        self.wait_converged()
+        time.sleep(1)
+        frames, loads = self.frames_rendered(), len(self.view_loads())
+        self.choose("preset-select", "CT-Muscle")
+        clicked = time.monotonic()
+        self.wait_converged(frames)
+        converged_after = time.monotonic() - clicked
+        time.sleep(1)  # the last frame's way to the browser
+        rendered, received = self.frames_rendered() - frames, len(self.view_loads()) - loads
+        passes = MAXIMUM_SAMPLES // SAMPLES_PER_PASS
+        print("restart to %d samples: %.1f s, %d passes, %d frames rendered, %d received"
+              % (MAXIMUM_SAMPLES, converged_after, passes, rendered, received))
+        self.assertTrue(passes <= rendered <= passes + 1, "one frame a pass")
+        self.assertTrue(rendered - 1 <= received <= rendered, "the browser gets them")
+
+        kept = self.frame(5, keep=True)
+        view = self.browser.execute_script(
+            "return Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0)"
+            ".reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b)")
+        mouse, loads = len(self.browser.execute_script("return window.mmrtmMouse")), len(self.view_loads())
+        drag = ActionChains(self.browser, duration=0).move_to_element(view).click_and_hold()
+        for _ in range(20):
+            drag.move_by_offset(8, 0).pause(0.1)
+        drag.release().perform()
+        time.sleep(0.5)
+        events = self.browser.execute_script("return window.mmrtmMouse")[mouse:]
+        moves = [t for kind, t in events if kind == "move"]
+        released = [t for kind, t in events if kind == "up"][-1]
+        during = [t for t in self.view_loads()[loads:] if moves[0] <= t <= released]
+        self.assertTrue(during, "frames during the drag")
+        latency, rate = (during[0] - moves[0]) / 1000, len(during) / ((released - moves[0]) / 1000)
+        print("drag: first preview %.3f s after the first move, %.1f frames a second over %.1f s (%d moves)"
+              % (latency, rate, (released - moves[0]) / 1000, len(moves)))
+        self.assertLessEqual(latency, 0.2)
+        self.assertGreaterEqual(rate, 5.0)
+        frames = self.frames_rendered()
+        self.wait_converged(frames)
+        rotated = self.frame(5)
+        print("converged again after the drag: mean change %.1f levels" % rotated[4])
+        self.assertGreater(rotated[4], 5.0, "the view turned")
+
+    def test_e_a_segmentation_shows_as_materials_and_a_hidden_segment_changes_its_part(self):
+        """A label map beside the chest CTA opens as a segmentation, its
+        segments named from the label table; hiding the aorta changes the
+        image, on the volume and not beside it. Catches a segmentation
+        that never reaches the display node, visibility that does not
+        reach the mapper, and a change drawn outside the volume."""
+        self.open_page()
+        self.frame(60)
+        self.assertEqual(self.open_study("cta_chest_aorta.nii.gz"), "")
+        self.choose("preset-select", "CT-Bone")
+        self.enter_path(".segmentation-path", "cta_chest_aorta_labels.nii.gz")
+        frames = self.frames_rendered()
+        self.click(".open-segmentation")
+        deadline, names = time.monotonic() + 30, []
+        while time.monotonic() < deadline and len(names) < 7:
+            time.sleep(0.25)
+            names = [e.text for e in self.browser.find_elements("css selector", ".segment-name")]
+        print("segments: %s (message: %r)" % (names, self.message()))
+        self.assertEqual(len(names), 7, "seven segments: %s" % names)
+        self.assertIn("aorta", names)
+        self.wait_converged(frames)
+        # The shift at its end moves CT-Bone's ramp beyond the volume's
+        # values: the segments are what remains.
+        self.frame(5, keep=True)
+        frames = self.frames_rendered()
+        self.browser.find_element("css selector", ".shift-slider .v-slider-thumb").send_keys(Keys.END)
+        self.wait_converged(frames)
+        shifted = self.frame(5, keep=True)
+        print("shifted to the end: coverage %.3f, mean change %.1f levels" % (shifted[2], shifted[4]))
+        self.assertGreater(shifted[4], 5.0, "the shift reaches the view")
+        self.browser.save_screenshot(os.path.join(OUTPUT, "mmrtm-web-segments.png"))
+        rows = self.browser.find_elements("css selector", ".segment-row")
+        aorta = [r for r in rows if r.find_element("css selector", ".segment-name").text == "aorta"][0]
+        frames = self.frames_rendered()
+        aorta.find_element("css selector", ".segment-visible input").click()
+        self.wait_converged(frames)
+        changed = self.frame(5)
+        on_volume, extent = self.browser.execute_script(CHANGE_ON_THE_VOLUME)
+        print("aorta hidden: mean change %.1f levels; changed pixels: %.3f of them on the volume, as many as %.3f "
+              "of the volume's" % (changed[4], on_volume, extent))
+        self.assertGreater(on_volume, 0.9, "the change is where the volume was")
+        self.assertGreater(extent, 0.3, "the aorta is most of what the shifted view shows")
+
+    def test_f_a_dicom_folder_of_two_series_offers_a_choice(self):
+        """A folder holding two DICOM series offers both, largest first,
+        and opens the one chosen. Catches a folder read as one series (two
+        studies' slices mixed into one volume)."""
+        self.open_page()
+        self.frame(60, keep=True)
+        self.enter_path(".study-path", "two_series")
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and not self.browser.find_elements("css selector", ".series-select"):
+            time.sleep(0.25)
+        self.browser.find_element("css selector", ".series-select .v-field").click()
+        deadline, items = time.monotonic() + 20, []
+        while time.monotonic() < deadline and len(items) < 2:
+            time.sleep(0.25)
+            items = [i.text for i in self.browser.find_elements("css selector", ".v-list-item") if "files" in i.text]
+        print("series offered: %s" % items)
+        self.assertEqual(len(items), 2, items)
+        self.assertIn("92 files", items[0])
+        self.assertIn("20 files", items[1])
+        self.browser.find_elements("css selector", ".v-list-item")[0].click()
+        self.assertEqual(self.open_study("two_series"), "", "the chosen series opens")
+        changed = self.frame(60, lambda s: 0 <= s[5] < 0.5)
+        print("the chest series: coverage %.3f, its silhouette's IoU with the head's %.3f" % (changed[2], changed[5]))
+
+    def test_g_uploads_are_checked(self):
+        """An upload over the server's limit is refused before it is sent,
+        a damaged one is reported, and the server goes on; a good one is
+        shown. Catches a server that reads any size it is sent or dies on
+        a damaged file."""
+        self.open_page()
+        self.frame(60)
+        self.assertEqual(self.open_study("ct_head_cranium.nrrd"), "")
+        self.frame(30, keep=True)
+        for name, expected in (("too_large.nrrd", "over the upload limit"), ("damaged.nrrd", "could not read")):
+            before = self.message()
+            upload = self.browser.find_element("css selector", ".upload-input input[type=file]")
+            upload.send_keys(os.path.join(self.uploads.name, name))
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline and self.message() in ("", before):
+                time.sleep(0.25)
+            print("%s: %s" % (name, self.message()))
+            self.assertIn(expected, self.message())
+            self.assertIsNone(self.server.poll(), "the server goes on after " + name)
+            self.browser.find_element("css selector", ".upload-input input[type=file]").clear()
+        upload = self.browser.find_element("css selector", ".upload-input input[type=file]")
+        upload.send_keys(os.path.join(self.uploads.name, "mr_head.nii.gz"))
+        shown = self.browser.find_element("css selector", ".shown-study")
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and "uploaded" not in shown.text:
+            time.sleep(0.25)
+        self.assertEqual(shown.text.strip(), "mr_head.nii.gz (uploaded)", self.message())
+        changed = self.frame(60, lambda s: 0 <= s[5] < 0.9)
+        print("the uploaded MR head: its silhouette's IoU with the CT head's %.3f" % changed[5])
+
+    def test_h_the_png_button_saves_the_path_traced_view(self):
+        """The PNG button downloads the 3D view at its size, lossless, with
+        the volume on it. Catches a screenshot of another view, of an
+        empty buffer, or of the JPEG stream's size."""
+        from vtkmodules.vtkIOImage import vtkPNGReader
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+
+        self.open_page()
+        width, height, coverage, _, _, _ = self.frame(60, lambda s: 0.02 < s[2] < 0.95)
+        self.wait_converged()
+        self.browser.find_element("css selector", ".screenshot").click()
+        deadline, saved = time.monotonic() + 30, []
+        while time.monotonic() < deadline and not saved:
+            time.sleep(0.25)
+            saved = [f for f in os.listdir(self.downloads.name) if f.endswith(".png")]
+        self.assertTrue(saved, "a PNG downloaded")
+        reader = vtkPNGReader()
+        reader.SetFileName(os.path.join(self.downloads.name, saved[0]))
+        reader.Update()
+        dimensions = reader.GetOutput().GetDimensions()
+        pixels = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())
+        print("%s: %s, mean %.1f, the stream's frame %d x %d" % (saved[0], dimensions, pixels.mean(), width, height))
+        self.assertEqual(saved[0], "mmrtm-web-%dspp.png" % MAXIMUM_SAMPLES)
+        self.assertEqual(dimensions[:2], (width, height))
+        self.assertGreater(pixels.mean(), 5.0)
+        self.assertGreater(pixels.std(), 10.0, "not one colour")
+
 
 if __name__ == "__main__":
     unittest.main()

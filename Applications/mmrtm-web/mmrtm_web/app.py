@@ -4,14 +4,18 @@
 
 Serves a page with Slicer's layouts (the 3D view path traced by our method,
 the axial, coronal and sagittal slices beside it), Slicer's Volume
-Rendering presets, and the studies of the data root to open. The 3D view refines in the background (the display
-node's AsynchronousRefinement), so the server answers the browser between
-sample passes. Documentation/web.md says what it does and does not do yet.
+Rendering presets, the shift, segmentations shown as materials, and the
+studies of the data root to open or a file to upload. The 3D view refines
+in the background (the display node's AsynchronousRefinement) and is
+streamed one frame per sample pass (streaming.py). Documentation/web.md
+says what it does and does not do yet.
 """
 import argparse
 import ipaddress
 import os
 import sys
+
+from .studies import DEFAULT_STUDY, StudyLoader
 
 METHOD = "vtkMRMLMultiMaterialVolumeRenderingDisplayNode"
 # The methods the page offers: ours, and Slicer's CPU ray cast to compare.
@@ -21,27 +25,21 @@ DEFAULT_PRESET = "CT-Bone"
 
 def parse_arguments(argv):
     parser = argparse.ArgumentParser(prog="mmrtm-web", description=__doc__.split("\n\n")[0])
-    parser.add_argument("volume", nargs="?", help="a volume file (NRRD, NIfTI, MetaImage) or a DICOM folder")
+    parser.add_argument("volume", nargs="?", default=DEFAULT_STUDY,
+                        help="a volume file (NRRD, NIfTI, MetaImage, InVesalius) or a DICOM folder "
+                        "(default: the head CT of Debian's invesalius-examples)")
     parser.add_argument("--data-root", help="the folder the page may open studies from (default: the study's "
                         "folder); paths that lead outside it are refused")
     parser.add_argument("--host", default="127.0.0.1", help="address to serve on (default: loopback only)")
     parser.add_argument("--port", type=int, default=8080, help="port (default 8080; 0: any free port)")
     parser.add_argument("--preset", default=DEFAULT_PRESET, help="Volume Rendering preset (default CT-Bone)")
     parser.add_argument("--maximum-samples", type=int, default=64, help="samples per pixel to refine to (default 64)")
+    parser.add_argument("--upload-limit-mb", type=float, default=512,
+                        help="largest file the page may upload, in MiB (default 512; 0: no uploads)")
+    parser.add_argument("--streaming", choices=("progressive", "trame-rca"), default="progressive",
+                        help="how the 3D view is streamed: one frame per sample pass (default), or trame-rca's "
+                        "own scheduler, to compare (Testing/Benchmarks/bench_web.py)")
     return parser.parse_args(argv)
-
-
-def volume_files(path):
-    """The files Slicer's volumes reader gets for `path`: a DICOM folder's
-    files (sorted), or the file itself. Raises ValueError naming the problem."""
-    if os.path.isdir(path):
-        files = sorted(os.path.join(path, f) for f in os.listdir(path) if os.path.isfile(os.path.join(path, f)))
-        if not files:
-            raise ValueError("the folder holds no files")
-        return files
-    if not os.path.isfile(path):
-        raise ValueError("no such file or folder")
-    return [path]
 
 
 def is_loopback(host):
@@ -51,18 +49,20 @@ def is_loopback(host):
         return host == "localhost"
 
 
+def hex_colour(rgb):
+    return "#%02x%02x%02x" % tuple(max(0, min(255, round(255 * c))) for c in rgb)
+
+
 class WebViewer:
     """The trame server, the Slicer core behind it, and the page."""
 
-    def __init__(self, volume_path, data_root, preset=DEFAULT_PRESET, maximum_samples=64, server=None):
+    def __init__(self, volume_path, data_root, preset=DEFAULT_PRESET, maximum_samples=64, upload_limit_mb=512,
+                 streaming="progressive", server=None):
         from trame.app import get_server
-        from trame.widgets import vuetify3
-        from trame_client.widgets import html
-        from trame_client.widgets.html import Div
         from trame_slicer.core import LayoutManager, SlicerApp
-        from trame_slicer.rca_view import register_rca_factories
-        from trame_vuetify.ui.vuetify3 import SinglePageLayout
         from slicer import vtkSlicerMultiMaterialVolumeRenderingLogic
+
+        from .streaming import ClientPresence, register_view_factories
 
         self.server = get_server(server, client_type="vue3")
         self.slicer = SlicerApp()
@@ -72,89 +72,155 @@ class WebViewer:
         self.volume_rendering = self.slicer.volume_rendering
         self.volume_rendering_logic = self.slicer.app_logic.GetModuleLogic("VolumeRendering")
         self.volume_rendering_logic.SetDefaultRenderingMethod(METHOD)
-        register_rca_factories(self.slicer.view_manager, self.server)
+        self.presence = ClientPresence(self.server)
+        if streaming == "progressive":
+            register_view_factories(self.slicer.view_manager, self.server, self.presence, self.on_frame)
+        else:
+            from trame_slicer.rca_view import register_rca_factories
+            register_rca_factories(self.slicer.view_manager, self.server)
         self.layouts = LayoutManager(self.slicer.scene, self.slicer.view_manager, self.server)
         self.layouts.register_layout_dict(LayoutManager.default_grid_configuration())
-        self.maximum_samples = maximum_samples
         self.data_root = data_root
+        self.studies = StudyLoader(self.slicer, data_root, upload_limit_mb)
         self.volume = None
+        self.segmentation = None
 
         state = self.server.state
         state.trame__title = "mmrtm-web"
         state.presets = self.volume_rendering.preset_names()
         state.preset = preset if preset in state.presets else (state.presets[0] if state.presets else "")
-        state.change("preset")(self.on_preset)
         state.methods = list(METHODS)
         state.method = state.methods[0]
-        state.change("method")(self.on_method)
         state.studies = data_root.studies()
         state.study = ""
+        state.series_items = []  # the chosen DICOM folder's series, when it has more than one
+        state.series = None
         state.shown = ""  # the study shown, as the data root names it
         state.message = ""
+        state.shift, state.shift_range = 0.0, [-1000.0, 1000.0]
+        state.samples_per_render, state.maximum_samples, state.noise_target = 4, maximum_samples, 0.0
+        state.samples, state.noise, state.refining, state.frames = 0, 0.0, False, 0
+        state.segmentation_path = ""
+        state.segments = []
+        state.upload_limit = int(upload_limit_mb * 1024 * 1024)
+        state.upload = None
+        state.change("preset")(self.on_preset)
+        state.change("method")(self.on_method)
+        state.change("study")(self.on_study_chosen)
+        state.change("shift")(self.on_shift)
+        state.change("samples_per_render", "maximum_samples", "noise_target")(self.on_sampling)
+        state.change("upload")(self.on_upload)
         self.server.controller.open_study = self.on_open_study
+        self.server.controller.open_segmentation = self.on_open_segmentation
+        self.server.controller.segment_visibility = self.on_segment_visibility
+        self.server.controller.segment_colour = self.on_segment_colour
+        self.server.trigger("screenshot")(self.screenshot_png)
 
-        with SinglePageLayout(self.server) as self.ui:
-            self.ui.title.set_text("mmrtm-web: path tracing (MM-RTM)")
-            with self.ui.toolbar:
-                vuetify3.VSpacer()
-                html.Span("{{ shown }}", classes="shown-study text-body-2 mr-4")
-                vuetify3.VCombobox(v_model=("study",), items=("studies",), label="Study (in the data root)",
-                                   density="compact", hide_details=True, style="max-width: 320px",
-                                   classes="study-path")
-                vuetify3.VBtn("Open", click=self.server.controller.open_study, classes="open-study")
-                vuetify3.VSelect(v_model=("preset",), items=("presets",), label="Preset", density="compact",
-                                 hide_details=True, style="max-width: 240px", classes="preset-select")
-                vuetify3.VSelect(v_model=("method",), items=("methods",), label="Rendering", density="compact",
-                                 hide_details=True, style="max-width: 240px", classes="method-select")
-            with self.ui.content:
-                vuetify3.VAlert(v_if=("message",), text=("message",), type="error", density="compact",
-                                closable=True, classes="study-message")
-                with Div(classes="fill-height d-flex flex-row flex-grow-1"):
-                    self.layouts.initialize_layout_grid(self.ui)
+        from .page import build_page
+        self.ui = build_page(self.server, self.layouts)
         self.layouts.set_layout("3D Primary")
+        if streaming != "progressive":
+            self.report_renders_of_trame_rca()
         path = data_root.resolve(volume_path)
         try:
-            self.volume = self.load(path)
+            self.show(self.studies.load(path))
         except ValueError as e:
             raise ValueError("%s: %s" % (path, e)) from e
         state.shown = os.path.relpath(path, data_root.folder)
 
-    def load(self, path):
-        """Loads the study, shows it path traced and in the slice views, in
-        place of the one shown before. Raises ValueError saying why when
-        Slicer's reader cannot read it (the study shown stays); the caller
-        names the path, as the page knows it."""
-        files = volume_files(path)
-        try:
-            nodes = self.slicer.io_manager.load_volumes(files)
-        except Exception as e:  # Slicer's reader raises what it likes on damaged input
-            raise ValueError("Slicer's volumes reader could not read it (%s)" % type(e).__name__) from e
-        if not nodes or nodes[0] is None:
-            raise ValueError("Slicer's volumes reader could not read it (damaged, or not a volume)")
-        volume = nodes[0]
+    def report_renders_of_trame_rca(self):
+        """The page's refinement state under trame-rca's scheduler, which
+        has no per-frame hook: after every render of the 3D view."""
+        from .streaming import path_traced_mappers
+
+        window = self.slicer.view_manager.get_threed_views()[0].render_window()
+        renders = [0]
+
+        def rendered(*_):
+            renders[0] += 1
+            self.on_frame(path_traced_mappers(window), renders[0])
+
+        window.AddObserver("EndEvent", rendered)
+
+    # The study, its display node and its segmentation.
+
+    def show(self, volume):
+        """Shows `volume` path traced and in the slice views, in place of
+        the study shown before."""
+        self.remove_segmentation()
         if self.volume is not None:
             shown = self.volume_rendering.get_vr_display_node(self.volume)
             if shown is not None:
                 self.slicer.scene.RemoveNode(shown)
             self.slicer.scene.RemoveNode(self.volume)
+        self.volume = volume
         self.slicer.display_manager.show_volume(volume, vr_preset=self.server.state.preset, do_reset_views=True)
-        self.configure(self.volume_rendering.get_vr_display_node(volume))
-        return volume
+        self.configure(self.display_node())
+        low, high = volume.GetImageData().GetScalarRange()
+        width = max(high - low, 1.0)
+        with self.server.state as state:
+            state.shift, state.shift_range = 0.0, [-width / 2, width / 2]
+
+    def display_node(self):
+        return self.volume_rendering.get_vr_display_node(self.volume) if self.volume is not None else None
 
     def configure(self, display):
         """Our settings on a display node of the chosen method (Volume
         Rendering makes a new node at each method change)."""
-        wanted = METHODS[self.server.state.method]
+        state = self.server.state
+        wanted = METHODS[state.method]
         if display is None or not display.IsA(wanted):
             raise RuntimeError("Volume Rendering made a %s, not a %s"
                                % (display.GetClassName() if display else "no node", wanted))
         if display.IsA(METHOD):
             display.SetAsynchronousRefinement(True)
-            display.SetMaximumSamples(self.maximum_samples)
+            display.SetSamplesPerRender(max(1, int(state.samples_per_render)))
+            display.SetMaximumSamples(max(1, int(state.maximum_samples)))
+            display.SetNoiseTarget(max(0.0, min(1.0, float(state.noise_target) / 100)))
+            if self.segmentation is not None:
+                display.SetAndObserveSegmentationNodeID(self.segmentation.GetID())
+
+    def remove_segmentation(self):
+        if self.segmentation is not None:
+            display = self.display_node()
+            if display is not None and display.IsA(METHOD):
+                display.SetAndObserveSegmentationNodeID(None)
+            self.slicer.scene.RemoveNode(self.segmentation)
+            self.segmentation = None
+        self.server.state.segments = []
+
+    def segments(self):
+        """The page's list of the segmentation's segments."""
+        if self.segmentation is None:
+            return []
+        listed = []
+        segmentation, display = self.segmentation.GetSegmentation(), self.segmentation.GetDisplayNode()
+        for index in range(segmentation.GetNumberOfSegments()):
+            segment_id = segmentation.GetNthSegmentID(index)
+            segment = segmentation.GetSegment(segment_id)
+            listed.append({"id": segment_id, "name": segment.GetName(), "colour": hex_colour(segment.GetColor()),
+                           "visible": bool(display.GetSegmentVisibility(segment_id)) if display else True})
+        return listed
+
+    # The page's actions.
+
+    def on_study_chosen(self, study, **_):
+        """A DICOM folder with several series: the page offers them."""
+        items, chosen = [], None
+        try:
+            series = self.studies.series_of(study)
+            if len(series) > 1:
+                items = [{"title": s.label(), "value": s.uid} for s in series]
+                chosen = series[0].uid
+        except ValueError:
+            pass  # Open says what is wrong with it
+        with self.server.state as state:
+            state.series_items, state.series = items, chosen
 
     def on_open_study(self):
-        """The page's Open: the study typed or chosen, if the data root holds
-        it; otherwise a message in the page (the server goes on)."""
+        """The page's Open: the study typed or chosen (the chosen series of
+        a DICOM folder), if the data root holds it; otherwise a message in
+        the page (the server goes on)."""
         state = self.server.state
         try:
             path = self.data_root.resolve(state.study)
@@ -162,11 +228,62 @@ class WebViewer:
             state.message = str(e)
             return
         try:
-            self.volume = self.load(path)
-            state.message = ""
-            state.shown = state.study
+            volume = self.studies.load(path, series=state.series if state.series_items else None)
         except ValueError as e:
             state.message = "'%s': %s" % (state.study, e)
+            return
+        self.show(volume)
+        state.message = ""
+        state.shown = state.study
+
+    def on_upload(self, upload, **_):
+        if not upload:
+            return
+        state = self.server.state
+        try:
+            volume, name = self.studies.load_upload(upload)
+        except ValueError as e:
+            state.message = str(e)
+        else:
+            self.show(volume)
+            state.message = ""
+            state.shown = "%s (uploaded)" % name
+        state.upload = None
+
+    def on_open_segmentation(self):
+        state = self.server.state
+        try:
+            path = self.data_root.resolve(state.segmentation_path)
+        except ValueError as e:
+            state.message = str(e)
+            return
+        try:
+            segmentation = self.studies.load_segmentation(path, self.volume)
+        except ValueError as e:
+            state.message = "'%s': %s" % (state.segmentation_path, e)
+            return
+        self.remove_segmentation()
+        self.segmentation = segmentation
+        display = self.display_node()
+        if display is not None and display.IsA(METHOD):
+            display.SetAndObserveSegmentationNodeID(segmentation.GetID())
+        state.segments = self.segments()
+        state.message = ""
+
+    def on_segment_visibility(self, segment_id, visible):
+        if self.segmentation is not None and self.segmentation.GetDisplayNode() is not None:
+            self.segmentation.GetDisplayNode().SetSegmentVisibility(str(segment_id), bool(visible))
+            self.server.state.segments = self.segments()
+
+    def on_segment_colour(self, segment_id, colour):
+        segment = self.segmentation.GetSegmentation().GetSegment(str(segment_id)) if self.segmentation else None
+        if segment is None or not isinstance(colour, str) or len(colour) != 7 or not colour.startswith("#"):
+            return
+        try:
+            segment.SetColor(*(int(colour[i:i + 2], 16) / 255 for i in (1, 3, 5)))
+        except ValueError:
+            return
+        self.server.state.segments = self.segments()
 
     def on_method(self, method, **_):
         if method not in METHODS:
@@ -174,11 +291,60 @@ class WebViewer:
         self.volume_rendering_logic.SetDefaultRenderingMethod(METHODS[method])
         if self.volume is not None:
             self.volume_rendering_logic.ChangeVolumeRenderingMethod(METHODS[method])
-            self.configure(self.volume_rendering.get_vr_display_node(self.volume))
+            self.configure(self.display_node())
 
     def on_preset(self, preset, **_):
-        if getattr(self, "volume", None) is not None and preset:
-            self.volume_rendering.apply_preset(self.volume_rendering.get_vr_display_node(self.volume), preset)
+        if self.volume is not None and preset:
+            self.volume_rendering.apply_preset(self.display_node(), preset)
+            self.server.state.shift = 0.0
+
+    def on_shift(self, shift, **_):
+        """Slicer's shift: the preset's functions moved along the values."""
+        if self.volume is None:
+            return
+        try:
+            shift = float(shift)
+        except (TypeError, ValueError):
+            return
+        self.volume_rendering.set_absolute_vr_shift_from_preset(self.volume, self.server.state.preset, shift)
+
+    def on_sampling(self, **_):
+        display = self.display_node()
+        if display is not None and display.IsA(METHOD):
+            try:
+                self.configure(display)
+            except (TypeError, ValueError):
+                pass  # a field being typed
+
+    def on_frame(self, mappers, frames):
+        """The refinement state of the frame just rendered, for the page."""
+        with self.server.state as state:
+            state.frames = frames
+            if not mappers:
+                state.samples, state.noise, state.refining = 0, 0.0, False
+                return
+            mapper = mappers[0]
+            state.samples = mapper.GetAccumulatedSamples()
+            state.noise = round(100 * mapper.GetRelativeNoise(), 2)
+            state.refining = not mapper.IsConverged()
+
+    def screenshot_png(self):
+        """The 3D view as it is now, as PNG bytes (lossless, unlike the
+        stream's JPEG frames)."""
+        from vtkmodules.vtkIOImage import vtkPNGWriter
+        from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+
+        window = self.slicer.view_manager.get_threed_views()[0].render_window()
+        capture = vtkWindowToImageFilter()
+        capture.SetInput(window)
+        capture.SetInputBufferTypeToRGB()
+        capture.ReadFrontBufferOff()
+        capture.Update()
+        writer = vtkPNGWriter()
+        writer.WriteToMemoryOn()
+        writer.SetInputConnection(capture.GetOutputPort())
+        writer.Write()
+        return bytes(memoryview(writer.GetResult()))
 
 
 def main(argv=None):
@@ -193,9 +359,11 @@ def main(argv=None):
     except ImportError as e:
         sys.exit("mmrtm-web: %s: it needs trame-slicer and the mmrtm wheel built with its Slicer classes "
                  "(pip install mmrtm[web]; Documentation/web.md)" % e)
-    if args.volume is None:
-        sys.exit("mmrtm-web: name a volume file or a DICOM folder (mmrtm-web --help)")
     from .data_root import DataRoot
+    if not os.path.exists(args.volume):
+        sys.exit("mmrtm-web: error: %s: no such file or folder%s" % (args.volume, (
+            " (the default study comes with Debian's invesalius-examples package)"
+            if args.volume == DEFAULT_STUDY else "")))
     try:
         root = DataRoot(args.data_root or os.path.dirname(os.path.abspath(args.volume.rstrip("/"))))
     except ValueError as e:
@@ -205,7 +373,8 @@ def main(argv=None):
               "reverse proxy that authenticates (Documentation/web.md)" % args.host, file=sys.stderr)
     try:
         viewer = WebViewer(os.path.abspath(args.volume), root, preset=args.preset,
-                           maximum_samples=args.maximum_samples)
+                           maximum_samples=args.maximum_samples, upload_limit_mb=args.upload_limit_mb,
+                           streaming=args.streaming)
     except ValueError as e:
         sys.exit("mmrtm-web: error: %s" % e)
     viewer.server.start(host=args.host, port=args.port, open_browser=False)

@@ -1,0 +1,187 @@
+"""Streaming fitted to a progressive renderer: one frame per change or
+finished sample pass, never more than one render in flight, and none while
+no browser is connected.
+
+trame-rca's image scheduler renders whenever asked and re-renders each
+frame at a higher JPEG quality shortly after. Our Slicer pipeline asks for
+another render at the end of every render until the image converges, so
+with it each sample pass was captured, encoded and pushed several times,
+and with synchronous refinement the server's event loop was blocked for a
+whole pass (a camera drag waited for refinement to end). With the display
+node's AsynchronousRefinement, a render returns at once (the first pass
+after a change is rendered in it, a fast preview during interaction) and
+the next pass runs on the tracer's threads. This scheduler then:
+
+- renders when the page or the scene asks (a camera move, a preset, a
+  resize): at once, between passes;
+- drops the requests made during its own render (the pipeline's "render
+  again, not converged yet"), and instead watches the mappers: when the
+  pass in flight has finished it renders once, which draws that pass and
+  starts the next, and pushes that frame;
+- pushes every frame at one JPEG quality (no second, still-quality render);
+- renders nothing while no browser is connected (a request waits for one).
+"""
+import asyncio
+
+from trame_rca.schedulers import RcaImageRenderScheduler
+
+
+def path_traced_mappers(render_window):
+    """Our mappers among the window's visible volumes."""
+    mappers = []
+    renderers = render_window.GetRenderers()
+    renderers.InitTraversal()
+    for _ in range(renderers.GetNumberOfItems()):
+        volumes = renderers.GetNextItem().GetVolumes()
+        volumes.InitTraversal()
+        for _ in range(volumes.GetNumberOfItems()):
+            volume = volumes.GetNextVolume()
+            mapper = volume.GetMapper()
+            if volume.GetVisibility() and mapper is not None and mapper.IsA("vtkMultiMaterialVolumeMapper"):
+                mappers.append(mapper)
+    return mappers
+
+
+class ClientPresence:
+    """How many browsers have the page open (trame's client life cycle)."""
+
+    def __init__(self, server):
+        self.count = 0
+        self.listeners = []
+        server.controller.on_client_connected.add(self.connected)
+        server.controller.on_client_exited.add(self.exited)
+
+    def connected(self):
+        self.count += 1
+        for listener in self.listeners:
+            listener()
+
+    def exited(self):
+        self.count = max(0, self.count - 1)
+
+    def __bool__(self):
+        return self.count > 0
+
+
+class ProgressiveRenderScheduler(RcaImageRenderScheduler):
+    """trame-rca's image scheduler with the render loop above. `presence`
+    says whether a browser is connected; `on_frame(mappers, frames)` is
+    called after each render with the frames pushed so far (the page's
+    refinement status)."""
+
+    # How often the pass in flight is checked: the delay between a pass's
+    # end and its frame's capture, at most.
+    POLL_S = 0.01
+
+    def __init__(self, window, *, presence, on_frame=None, quality=80, **kwargs):
+        kwargs["interactive_quality"] = quality
+        kwargs["still_quality"] = quality
+        self.presence = presence
+        self.on_frame = on_frame
+        self.frames = 0
+        self.stalled_at = None
+        self.pushed = None  # progress() when the last frame was rendered
+        # The VTK window behind trame-rca's area: its `render_window`
+        # property renders, which this must not do to look at the mappers.
+        self.render_window = window._vtk_render_window
+        super().__init__(window, **kwargs)
+        presence.listeners.append(self.schedule_render)
+
+    def mappers(self):
+        return path_traced_mappers(self.render_window)
+
+    async def _next_render(self):
+        """Waits until a frame is due: a request, or (while refining) the
+        end of the pass in flight. Returns False when closing."""
+        while not self._is_closing:
+            if not self.presence:
+                await asyncio.sleep(0.1)
+                continue
+            if self._request_event.is_set():
+                return True
+            mappers = self.mappers()
+            if any(m.IsRefining() for m in mappers):
+                await asyncio.sleep(self.POLL_S)
+                continue
+            # Not converged: a pass has ended (draw it, start the next), a
+            # change's first pass was drawn (start the next), or an
+            # interaction has ended and the last frame was its preview
+            # (trame-rca's interactor does not render at the end of an
+            # interaction, so nothing else asks), unless _render found that
+            # rendering again would give nothing new.
+            if any(not m.IsConverged() for m in mappers) and self.progress(mappers) != self.stalled_at:
+                return True
+            try:
+                await asyncio.wait_for(self._request_event.wait(), timeout=0.25)
+            except asyncio.TimeoutError:
+                pass
+        return False
+
+    def progress(self, mappers):
+        """What a render may change: the samples, and whether the window
+        renders previews (an interaction sets its desired update rate)."""
+        return [m.GetAccumulatedSamples() for m in mappers], self.render_window.GetDesiredUpdateRate()
+
+    def push_frame(self):
+        self._render_frame(self._interactive_quality)
+        self.frames += 1
+
+    async def _render(self):
+        while await self._next_render():
+            requested = self._request_event.is_set()
+            self._request_event.clear()
+            mappers = self.mappers()
+            before = self.progress(mappers)
+            if not requested and before == self.pushed:
+                # Asked by nothing: a pass has ended, or a change's first
+                # pass was drawn and this render only starts the next one
+                # in the background. Only a render that drew new samples
+                # is captured (by rendering again, which only redraws).
+                self.render_window.Render()
+                if self.progress(self.mappers()) != before:
+                    self.push_frame()
+            else:
+                self.push_frame()
+            # The requests made during the render are the pipeline's
+            # "not converged, render again": _next_render answers them
+            # when the pass ends.
+            self._request_event.clear()
+            mappers = self.mappers()
+            after = self.progress(mappers)
+            self.pushed = after
+            # Nothing more comes of rendering again without a request or a
+            # change of mode: after an interaction's preview (no samples
+            # accumulate), or after a render that was not asked for and
+            # neither drew samples nor started a pass.
+            preview = mappers and not any(after[0])
+            idle = not any(m.IsRefining() for m in mappers)
+            self.stalled_at = after if idle and (preview or (not requested and after == before)) else None
+            if self.on_frame is not None:
+                self.on_frame(mappers, self.frames)
+            await asyncio.sleep(0)  # the browser's events first
+
+
+def register_view_factories(view_manager, server, presence, on_frame):
+    """trame-slicer's remote views: its slice views as they are, its 3D
+    view streamed by ProgressiveRenderScheduler."""
+    from trame_slicer.app.ui import create_vertical_slice_view_gutter_ui, create_vertical_view_gutter_ui
+    from trame_slicer.rca_view import rca_view_factory
+
+    class ThreeDViewFactory(rca_view_factory.RemoteThreeDViewFactory):
+        def _create_view(self, view, scene, app_logic):
+            # trame-slicer makes its scheduler inline, by the module's name
+            # for it; ours stands in for it while this view is made.
+            class Scheduler(ProgressiveRenderScheduler):
+                def __init__(self, window, **kwargs):
+                    super().__init__(window, presence=presence, on_frame=on_frame, **kwargs)
+
+            original = rca_view_factory.RcaImageRenderScheduler
+            rca_view_factory.RcaImageRenderScheduler = Scheduler
+            try:
+                return super()._create_view(view, scene, app_logic)
+            finally:
+                rca_view_factory.RcaImageRenderScheduler = original
+
+    view_manager.register_factory(rca_view_factory.RemoteSliceViewFactory(
+        server, populate_view_ui_f=create_vertical_slice_view_gutter_ui))
+    view_manager.register_factory(ThreeDViewFactory(server, populate_view_ui_f=create_vertical_view_gutter_ui))
