@@ -211,10 +211,11 @@ int main(int argc, char** argv) {
       lookups += paths.lookups[i].size();
       segments += paths.segments[i];
     }
-    std::printf("{\"volume\": \"%s\", \"camera_paths\": %llu, \"lookups_per_path\": %.2f, "
-                "\"segments_per_path\": %.2f, \"occupancy\": [\n",
-                volume.c_str(), (unsigned long long)pathsInVolume, (double)lookups / std::max<uint64_t>(pathsInVolume, 1),
-                (double)segments / std::max<uint64_t>(pathsInVolume, 1));
+    std::printf(
+        "{\"volume\": \"%s\", \"camera_paths\": %llu, \"lookups_per_path\": %.2f, "
+        "\"segments_per_path\": %.2f, \"occupancy\": [\n",
+        volume.c_str(), (unsigned long long)pathsInVolume, (double)lookups / std::max<uint64_t>(pathsInVolume, 1),
+        (double)segments / std::max<uint64_t>(pathsInVolume, 1));
     for (int lanes : {4, 8, 16}) {
       PrintOccupancy(paths, lanes);
       std::printf(lanes == 16 ? "\n" : ",\n");
@@ -244,10 +245,11 @@ int main(int argc, char** argv) {
       size_t nonzero = 0;
       for (float s : out) nonzero += s > 0.f;
       for (size_t m = 0; m < modes.size(); ++m) {
-        std::printf("%s  {\"points\": \"%s\", \"count\": %zu, \"nonzero\": %.3f, \"mode\": \"%s\", \"seconds\": %.5f, "
-                    "\"per_second\": %.4g, \"speedup_over_scalar\": %.3f}",
-                    firstLine ? "" : ",\n", set.name.c_str(), n, (double)nonzero / n, modes[m].name.c_str(), best[m],
-                    n / best[m], best[0] / best[m]);
+        std::printf(
+            "%s  {\"points\": \"%s\", \"count\": %zu, \"nonzero\": %.3f, \"mode\": \"%s\", \"seconds\": %.5f, "
+            "\"per_second\": %.4g, \"speedup_over_scalar\": %.3f}",
+            firstLine ? "" : ",\n", set.name.c_str(), n, (double)nonzero / n, modes[m].name.c_str(), best[m],
+            n / best[m], best[0] / best[m]);
         firstLine = false;
       }
     }

@@ -3,12 +3,14 @@
 // once per Highway target, inside HWY_NAMESPACE (foreach_target.h), hence
 // the toggled guard instead of #pragma once.
 //
-// The members are `inline`, not always-inline: the per-lane templates they
-// are called from are defined outside the per-target region and are
-// compiled for the baseline instruction set, so they can take no
-// always-inline call of a wider target. The entry point of each target is
-// HWY_FLATTEN, which inlines the templates into it and these members after
-// them, all under the target's instruction set.
+// The per-lane templates that use this type are defined outside the
+// per-target code and so are compiled for the baseline instruction set:
+// they may make no always-inline call of a wider target (Highway's own
+// operations are always-inline), hence the members and operators here are
+// plain `inline`. The templates are MMRTM_INLINE and each target's entry
+// point is HWY_FLATTEN, so that all of it is inlined into the target's
+// code (with GCC; clang 14 leaves some of a target's own functions out of
+// line, which are compiled for that target all the same).
 #if defined(MMRTM_SIMD_HIGHWAY_LANES_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef MMRTM_SIMD_HIGHWAY_LANES_INL_H_
 #undef MMRTM_SIMD_HIGHWAY_LANES_INL_H_

@@ -131,7 +131,7 @@ struct Classifier {
     return tfs[bindings[materials[0].bindingBegin].tf];
   }
   template <class L>
-  MMRTM_CPU_GPU typename L::Float PlainExtinction(typename L::Float density) const {
+  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float PlainExtinction(typename L::Float density) const {
     return L::Min(L::Splat(materials[0].base[0]) * density, L::Splat(maxExtinction));
   }
 

@@ -19,6 +19,10 @@
 // A SIMD lane type (cuda/simd, host only: nvcc never sees it) provides the
 // same over N lanes; control flow that depends on lane values goes through
 // AnyTrue/AllTrue, which for one lane are the plain branch.
+// The per-lane templates are MMRTM_INLINE: they are defined outside any
+// SIMD target's code, so a SIMD instantiation left out of line would be
+// compiled for the baseline instruction set, and would take its vectors
+// in memory (cuda/simd/highway_lanes-inl.h).
 #pragma once
 
 #include "mmrtm/defs.h"
@@ -55,7 +59,7 @@ struct ScalarLanes {
 // (1 - t) a + t b, the one interpolation of every lookup and curve (vecmath's
 // Lerp is this for ScalarLanes).
 template <class L>
-MMRTM_CPU_GPU typename L::Float LerpLanes(typename L::Float t, typename L::Float a, typename L::Float b) {
+MMRTM_INLINE MMRTM_CPU_GPU typename L::Float LerpLanes(typename L::Float t, typename L::Float a, typename L::Float b) {
   return (L::Splat(1.f) - t) * a + t * b;
 }
 

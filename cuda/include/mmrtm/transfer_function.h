@@ -104,7 +104,7 @@ struct TransferFunctionView {
   // between the first and the last key. (A lane whose x is outside gets
   // some lo in [-1, count - 1]; its caller takes an end value instead.)
   template <class L>
-  MMRTM_CPU_GPU typename L::Int CurveSegment(typename L::Float x) const {
+  MMRTM_INLINE MMRTM_CPU_GPU typename L::Int CurveSegment(typename L::Float x) const {
     using Float = typename L::Float;
     using Int = typename L::Int;
     using Mask = typename L::Mask;
@@ -131,7 +131,7 @@ struct TransferFunctionView {
   // the estimate's range). Lanes whose search has closed keep reading their
   // own lo, in bounds.
   template <class L>
-  MMRTM_CPU_GPU typename L::Int BisectCurve(typename L::Float x) const {
+  MMRTM_INLINE MMRTM_CPU_GPU typename L::Int BisectCurve(typename L::Float x) const {
     using Int = typename L::Int;
     using Mask = typename L::Mask;
     Int lo = L::SplatInt(0), hi = L::SplatInt(count - 1);  // keys[lo] <= x < keys[hi]
@@ -147,14 +147,14 @@ struct TransferFunctionView {
 
   // CCTF: x's position in segment lo, 0 at keys[lo] and 1 at keys[lo + 1].
   template <class L>
-  MMRTM_CPU_GPU typename L::Float CurveFraction(typename L::Float x, typename L::Int lo) const {
+  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float CurveFraction(typename L::Float x, typename L::Int lo) const {
     const typename L::Float k0 = L::Gather(keys, lo), k1 = L::Gather(keys, lo + L::SplatInt(1));
     return (x - k0) / (k1 - k0);
   }
 
   // CCTF: channel c at fraction t of segment lo.
   template <class L>
-  MMRTM_CPU_GPU typename L::Float CurveChannel(typename L::Float t, typename L::Int lo, int c) const {
+  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float CurveChannel(typename L::Float t, typename L::Int lo, int c) const {
     const typename L::Int first = lo * L::SplatInt(channels) + L::SplatInt(c);
     return LerpLanes<L>(t, L::Gather(values, first), L::Gather(values, first + L::SplatInt(channels)));
   }

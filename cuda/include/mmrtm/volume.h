@@ -29,8 +29,8 @@ MMRTM_CPU_GPU inline int VoxelTypeSize(VoxelType t) {
 // takes NaN to 0); then the cell's first corner, at least 0 and at most
 // lastCell; and p's fraction within that cell.
 template <class L>
-MMRTM_CPU_GPU void TrilinearAxis(typename L::Float p, float last, int lastCell, typename L::Int* corner,
-                                 typename L::Float* t) {
+MMRTM_INLINE MMRTM_CPU_GPU void TrilinearAxis(typename L::Float p, float last, int lastCell, typename L::Int* corner,
+                                              typename L::Float* t) {
   const typename L::Float f = L::Min(L::Max(p, L::Splat(0.f)), L::Splat(last));
   *corner = L::MinInt(L::Truncate(f), L::SplatInt(lastCell));
   *t = f - L::ToFloat(*corner);
@@ -40,17 +40,19 @@ MMRTM_CPU_GPU void TrilinearAxis(typename L::Float p, float last, int lastCell, 
 // clamped before the truncating conversion (which is the floor on [0,
 // last]), and 0 for NaN.
 template <class L>
-MMRTM_CPU_GPU typename L::Int NearestAxis(typename L::Float p, float last) {
+MMRTM_INLINE MMRTM_CPU_GPU typename L::Int NearestAxis(typename L::Float p, float last) {
   return L::Truncate(L::Min(L::Max(p + L::Splat(0.5f), L::Splat(0.f)), L::Splat(last)));
 }
 
 // Trilinear interpolation in a cell from its corner values cXYZ (X, Y, Z: 0
 // at the first corner, 1 at the far one) at fractions t within it.
 template <class L>
-MMRTM_CPU_GPU typename L::Float InterpolateCell(typename L::Float c000, typename L::Float c100, typename L::Float c010,
-                                                typename L::Float c110, typename L::Float c001, typename L::Float c101,
-                                                typename L::Float c011, typename L::Float c111, typename L::Float tx,
-                                                typename L::Float ty, typename L::Float tz) {
+MMRTM_INLINE MMRTM_CPU_GPU typename L::Float InterpolateCell(typename L::Float c000, typename L::Float c100,
+                                                             typename L::Float c010, typename L::Float c110,
+                                                             typename L::Float c001, typename L::Float c101,
+                                                             typename L::Float c011, typename L::Float c111,
+                                                             typename L::Float tx, typename L::Float ty,
+                                                             typename L::Float tz) {
   const typename L::Float c00 = LerpLanes<L>(tx, c000, c100), c10 = LerpLanes<L>(tx, c010, c110);
   const typename L::Float c01 = LerpLanes<L>(tx, c001, c101), c11 = LerpLanes<L>(tx, c011, c111);
   return LerpLanes<L>(tz, LerpLanes<L>(ty, c00, c10), LerpLanes<L>(ty, c01, c11));
