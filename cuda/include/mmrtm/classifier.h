@@ -11,6 +11,7 @@
 
 #include "mmrtm/defs.h"
 #include "mmrtm/material.h"
+#include "mmrtm/scalar_lanes.h"
 #include "mmrtm/transfer_function.h"
 #include "mmrtm/volume.h"
 
@@ -124,6 +125,16 @@ struct Classifier {
     return d;
   }
 
+  // A plain scene's one density TF, and the extinction where it gives
+  // `density` (per lane: the SIMD lookup in cuda/simd runs this too).
+  MMRTM_CPU_GPU const TransferFunctionView& PlainDensityTF() const {
+    return tfs[bindings[materials[0].bindingBegin].tf];
+  }
+  template <class L>
+  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float PlainExtinction(typename L::Float density) const {
+    return L::Min(L::Splat(materials[0].base[0]) * density, L::Splat(maxExtinction));
+  }
+
   MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
     return Classify(world, proxies[0].worldToIndex.ApplyPoint(world));
   }
@@ -142,8 +153,8 @@ struct Classifier {
     if (shortest) {
       c.proxies.v[0] = proxies[0].SampleIndex(index0);
       float v;
-      tfs[bindings[materials[0].bindingBegin].tf].Evaluate(c.proxies.v[0], &v);
-      c.sigma_t = Min(materials[0].base[0] * v, maxExtinction);
+      PlainDensityTF().Evaluate(c.proxies.v[0], &v);
+      c.sigma_t = PlainExtinction<ScalarLanes>(v);
       c.material = 0;
       return c;
     }
