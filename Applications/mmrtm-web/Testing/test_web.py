@@ -593,6 +593,42 @@ class WebViewerTest(unittest.TestCase):
         self.assertGreater(pixels.mean(), 5.0)
         self.assertGreater(pixels.std(), 10.0, "not one colour")
 
+    def test_i_the_transfer_function_editor_reaches_the_view(self):
+        """The editor lists the preset's opacity and colour points; every
+        opacity set to 0 (each slider's Home key) empties the view, and a
+        colour point changed recolours it. Catches an editor that shows
+        points but edits nothing, or edits another property than the one
+        rendered."""
+        self.open_page()
+        self.frame(60)
+        self.assertEqual(self.open_study("ct_head_cranium.nrrd"), "")
+        self.choose("preset-select", "CT-Muscle")
+        self.wait_converged()
+        kept = self.frame(5, keep=True)
+        self.browser.find_element("css selector", ".transfer-function-editor .v-expansion-panel-title").click()
+        time.sleep(1)
+        colours = self.browser.find_elements("css selector", ".colour-point input[type=color]")
+        sliders = self.browser.find_elements("css selector", ".opacity-y .v-slider-thumb")
+        print("points: %d opacity, %d colour" % (len(sliders), len(colours)))
+        self.assertGreater(len(sliders), 1)
+        self.assertGreater(len(colours), 1)
+        frames = self.frames_rendered()
+        for colour in colours:
+            self.browser.execute_script(
+                "arguments[0].value = '#00ff00'; arguments[0].dispatchEvent(new Event('change'))", colour)
+        self.wait_converged(frames)
+        green = self.frame(5)
+        self.browser.save_screenshot(os.path.join(OUTPUT, "mmrtm-web-editor.png"))
+        print("every colour point green: mean change %.1f levels" % green[4])
+        self.assertGreater(green[4], 5.0)
+        frames = self.frames_rendered()
+        for slider in self.browser.find_elements("css selector", ".opacity-y .v-slider-thumb"):
+            slider.send_keys(Keys.HOME)
+        self.wait_converged(frames)
+        empty = self.frame(5)
+        print("every opacity 0: coverage %.4f (before %.3f)" % (empty[2], kept[2]))
+        self.assertLess(empty[2], 0.01)
+
 
 if __name__ == "__main__":
     unittest.main()

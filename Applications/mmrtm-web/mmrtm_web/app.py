@@ -15,7 +15,9 @@ import ipaddress
 import os
 import sys
 
+from . import transfer_functions
 from .studies import DEFAULT_STUDY, StudyLoader
+from .transfer_functions import hex_colour
 
 METHOD = "vtkMRMLMultiMaterialVolumeRenderingDisplayNode"
 # The methods the page offers: ours, and Slicer's CPU ray cast to compare.
@@ -47,10 +49,6 @@ def is_loopback(host):
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return host == "localhost"
-
-
-def hex_colour(rgb):
-    return "#%02x%02x%02x" % tuple(max(0, min(255, round(255 * c))) for c in rgb)
 
 
 class WebViewer:
@@ -100,6 +98,7 @@ class WebViewer:
         state.shift, state.shift_range = 0.0, [-1000.0, 1000.0]
         state.samples_per_render, state.maximum_samples, state.noise_target = 4, maximum_samples, 0.0
         state.samples, state.noise, state.refining, state.frames = 0, 0.0, False, 0
+        state.opacity_points, state.colour_points = [], []
         state.segmentation_path = ""
         state.segments = []
         state.upload_limit = int(upload_limit_mb * 1024 * 1024)
@@ -114,6 +113,8 @@ class WebViewer:
         self.server.controller.open_segmentation = self.on_open_segmentation
         self.server.controller.segment_visibility = self.on_segment_visibility
         self.server.controller.segment_colour = self.on_segment_colour
+        self.server.controller.opacity_point = self.on_opacity_point
+        self.server.controller.colour_point = self.on_colour_point
         self.server.trigger("screenshot")(self.screenshot_png)
 
         from .page import build_page
@@ -160,6 +161,19 @@ class WebViewer:
         width = max(high - low, 1.0)
         with self.server.state as state:
             state.shift, state.shift_range = 0.0, [-width / 2, width / 2]
+        self.show_transfer_functions()
+
+    def volume_property(self):
+        display = self.display_node()
+        node = display.GetVolumePropertyNode() if display is not None else None
+        return node.GetVolumeProperty() if node is not None else None
+
+    def show_transfer_functions(self):
+        """The editor's lists, from the volume property as it is now."""
+        volume_property = self.volume_property()
+        with self.server.state as state:
+            state.opacity_points = transfer_functions.opacity_points(volume_property) if volume_property else []
+            state.colour_points = transfer_functions.colour_points(volume_property) if volume_property else []
 
     def display_node(self):
         return self.volume_rendering.get_vr_display_node(self.volume) if self.volume is not None else None
@@ -297,6 +311,7 @@ class WebViewer:
         if self.volume is not None and preset:
             self.volume_rendering.apply_preset(self.display_node(), preset)
             self.server.state.shift = 0.0
+            self.show_transfer_functions()
 
     def on_shift(self, shift, **_):
         """Slicer's shift: the preset's functions moved along the values."""
@@ -307,6 +322,20 @@ class WebViewer:
         except (TypeError, ValueError):
             return
         self.volume_rendering.set_absolute_vr_shift_from_preset(self.volume, self.server.state.preset, shift)
+        self.show_transfer_functions()
+
+    def on_opacity_point(self, index, field, value):
+        """The editor: a point of the opacity function moved (field "x")
+        or set to another opacity (field "y")."""
+        volume_property = self.volume_property()
+        if volume_property is not None and field in ("x", "y") and transfer_functions.set_opacity_point(
+                volume_property, index, **{field: value}):
+            self.show_transfer_functions()
+
+    def on_colour_point(self, index, colour):
+        volume_property = self.volume_property()
+        if volume_property is not None and transfer_functions.set_colour_point(volume_property, index, colour):
+            self.show_transfer_functions()
 
     def on_sampling(self, **_):
         display = self.display_node()

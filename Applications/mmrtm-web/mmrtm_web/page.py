@@ -52,6 +52,27 @@ def build_page(server, layouts):
                 vuetify3.VSlider(v_model=("shift",), min=("shift_range[0]",), max=("shift_range[1]",),
                                  label="Shift", density="compact", hide_details=True, thumb_label=True,
                                  step=1, classes="shift-slider")
+                with vuetify3.VExpansionPanels(variant="accordion", classes="transfer-function-editor"):
+                    with vuetify3.VExpansionPanel(title="Transfer functions"):
+                        with vuetify3.VExpansionPanelText():
+                            html.Div("Opacity: value, opacity", classes="text-caption")
+                            with Div(v_for="(point, i) in opacity_points", key="'o' + i",
+                                     classes="d-flex flex-row align-center ga-2 opacity-point"):
+                                vuetify3.VTextField(model_value=("point.x",), type="number", density="compact",
+                                                    hide_details=True, variant="underlined",
+                                                    style="max-width: 90px", classes="opacity-x",
+                                                    change=(ctrl.opacity_point, "[i, 'x', $event.target.value]"))
+                                vuetify3.VSlider(model_value=("point.y",), min=0, max=1, step=0.01,
+                                                 density="compact", hide_details=True, thumb_label=True,
+                                                 classes="opacity-y",
+                                                 update_modelValue=(ctrl.opacity_point, "[i, 'y', $event]"))
+                            html.Div("Colour: value, colour", classes="text-caption mt-2")
+                            with Div(v_for="(point, i) in colour_points", key="'c' + i",
+                                     classes="d-flex flex-row align-center ga-2 colour-point"):
+                                html.Span("{{ point.x }}", classes="text-body-2", style="min-width: 90px")
+                                html.Input(type="color", value=("point.colour",),
+                                           change=(ctrl.colour_point, "[i, $event.target.value]"),
+                                           style="width: 28px; height: 22px")
                 vuetify3.VSelect(v_model=("method",), items=("methods",), label="Rendering", density="compact",
                                  hide_details=True, classes="method-select")
                 html.Div("Refinement", classes="text-subtitle-2 mt-2")
