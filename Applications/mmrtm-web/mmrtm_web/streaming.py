@@ -17,7 +17,10 @@ the next pass runs on the tracer's threads. This scheduler then:
 - drops the requests made during its own render (the pipeline's "render
   again, not converged yet"), and instead watches the mappers: when the
   pass in flight has finished it renders once, which draws that pass and
-  starts the next, and pushes that frame;
+  starts the next, and pushes that frame (a render that only starts a
+  pass is not pushed);
+- renders the still frame after an interaction ends (trame-rca's
+  interactor does not render then; the last frame was a preview);
 - pushes every frame at one JPEG quality (no second, still-quality render);
 - renders nothing while no browser is connected (a request waits for one).
 """
