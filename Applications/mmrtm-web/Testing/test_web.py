@@ -28,13 +28,8 @@ CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 MAXIMUM_SAMPLES, SAMPLES_PER_PASS = 32, 4  # the server's --maximum-samples; the display node's default
 
 # The 3D view's frame: the largest streamed <img>, drawn into a canvas to
-# read its pixels. The background is a vertical gradient, so a pixel is the
-# volume's where it differs from the first pixel of its row. Returns
-# [width, height, fraction of the volume's pixels, mean brightness, mean
-# change from the kept frame (-1 if none of this size), the volume's
-# pixels' intersection over union with the kept frame's (-1 if none)], or
-# null before the first frame; arguments[0] keeps this frame.
-FRAME_STATISTICS = """
+# read its pixels (width w, height h, RGBA p); null before the first frame.
+FRAME_PIXELS = """
 const images = Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
 if (!images.length) return null;
 const img = images.reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b);
@@ -44,6 +39,16 @@ canvas.width = w; canvas.height = h;
 const context = canvas.getContext('2d');
 context.drawImage(img, 0, 0);
 const p = context.getImageData(0, 0, w, h).data;
+"""
+
+# The frame's statistics. The background is a vertical gradient, so a
+# pixel is the volume's where it differs from the first pixel of its row.
+# Returns
+# [width, height, fraction of the volume's pixels, mean brightness, mean
+# change from the kept frame (-1 if none of this size), the volume's
+# pixels' intersection over union with the kept frame's (-1 if none)], or
+# null before the first frame; arguments[0] keeps this frame.
+FRAME_STATISTICS = FRAME_PIXELS + """
 const mask = new Uint8Array(w * h);
 const kept = window.mmrtmKeptFrame, keptMask = window.mmrtmKeptMask;
 const comparable = kept && kept.length === p.length;
@@ -72,14 +77,7 @@ return [w, h, covered / n, sum / n / 3, comparable ? change / n / 3 : -1,
 
 # The same frame's volume pixels as a string of 0 and 1 (FRAME_STATISTICS'
 # rule), to compare two frames in Python.
-FRAME_MASK = """
-const images = Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
-const img = images.reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b);
-const canvas = document.createElement('canvas');
-const w = img.naturalWidth, h = img.naturalHeight;
-canvas.width = w; canvas.height = h;
-canvas.getContext('2d').drawImage(img, 0, 0);
-const p = canvas.getContext('2d').getImageData(0, 0, w, h).data;
+FRAME_MASK = FRAME_PIXELS + """
 const bits = new Array(w * h);
 for (let y = 0; y < h; y++) {
   const r = 4 * y * w;
@@ -95,14 +93,7 @@ return w + 'x' + h + ':' + bits.join('');
 # Of the pixels that changed (by over 30 levels) since the kept frame: the
 # fraction that lie on the kept frame's volume, and their number over the
 # kept frame's volume pixels; [-1, 0] if none changed.
-CHANGE_ON_THE_VOLUME = """
-const images = Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
-const img = images.reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b);
-const canvas = document.createElement('canvas');
-const w = img.naturalWidth, h = img.naturalHeight;
-canvas.width = w; canvas.height = h;
-canvas.getContext('2d').drawImage(img, 0, 0);
-const p = canvas.getContext('2d').getImageData(0, 0, w, h).data;
+CHANGE_ON_THE_VOLUME = FRAME_PIXELS + """
 const kept = window.mmrtmKeptFrame, keptMask = window.mmrtmKeptMask;
 if (!kept || kept.length !== p.length) return -1;
 let changed = 0, onVolume = 0, volume = 0;

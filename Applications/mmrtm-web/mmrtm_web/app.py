@@ -231,24 +231,32 @@ class WebViewer:
         with self.server.state as state:
             state.series_items, state.series = items, chosen
 
-    def on_open_study(self):
-        """The page's Open: the study typed or chosen (the chosen series of
-        a DICOM folder), if the data root holds it; otherwise a message in
-        the page (the server goes on)."""
+    def open_from_data_root(self, typed, load):
+        """load(path) of the path the page typed or chose, resolved in the
+        data root; None, with a message in the page naming the path as
+        typed, when it leads outside the root or cannot be read (the
+        server goes on)."""
+        try:
+            path = self.data_root.resolve(typed)
+        except ValueError as e:
+            self.server.state.message = str(e)
+            return None
+        try:
+            return load(path)
+        except ValueError as e:
+            self.server.state.message = "'%s': %s" % (typed, e)
+            return None
+
+    def on_open_study(self, study, series=None):
+        """The page's Open: the study typed or chosen (and the chosen series
+        of a DICOM folder of several)."""
         state = self.server.state
-        try:
-            path = self.data_root.resolve(state.study)
-        except ValueError as e:
-            state.message = str(e)
-            return
-        try:
-            volume = self.studies.load(path, series=state.series if state.series_items else None)
-        except ValueError as e:
-            state.message = "'%s': %s" % (state.study, e)
+        volume = self.open_from_data_root(study, lambda path: self.studies.load(path, series=series))
+        if volume is None:
             return
         self.show(volume)
         state.message = ""
-        state.shown = state.study
+        state.shown = study
 
     def on_upload(self, upload, **_):
         if not upload:
@@ -264,17 +272,11 @@ class WebViewer:
             state.shown = "%s (uploaded)" % name
         state.upload = None
 
-    def on_open_segmentation(self):
+    def on_open_segmentation(self, segmentation_path):
         state = self.server.state
-        try:
-            path = self.data_root.resolve(state.segmentation_path)
-        except ValueError as e:
-            state.message = str(e)
-            return
-        try:
-            segmentation = self.studies.load_segmentation(path, self.volume)
-        except ValueError as e:
-            state.message = "'%s': %s" % (state.segmentation_path, e)
+        segmentation = self.open_from_data_root(
+            segmentation_path, lambda path: self.studies.load_segmentation(path, self.volume))
+        if segmentation is None:
             return
         self.remove_segmentation()
         self.segmentation = segmentation

@@ -42,7 +42,10 @@ def build_page(server, layouts):
                                    density="compact", hide_details=True, classes="study-path")
                 vuetify3.VSelect(v_if=("series_items.length",), v_model=("series",), items=("series_items",),
                                  label="Series", density="compact", hide_details=True, classes="series-select")
-                vuetify3.VBtn("Open", click=ctrl.open_study, classes="open-study")
+                # The button sends what the page shows: a state update may
+                # still wait behind a render when the click arrives.
+                vuetify3.VBtn("Open", click=(ctrl.open_study, "[study, series_items.length ? series : null]"),
+                              classes="open-study")
                 vuetify3.VFileInput(label="Upload (NRRD, NIfTI, MetaImage .mha)", density="compact",
                                     hide_details=True, show_size=True, classes="upload-input",
                                     update_modelValue=UPLOAD_CHECK)
@@ -89,7 +92,7 @@ def build_page(server, layouts):
                 vuetify3.VCombobox(v_model=("segmentation_path",), items=("studies",),
                                    label="Label map or segmentation", density="compact", hide_details=True,
                                    classes="segmentation-path")
-                vuetify3.VBtn("Show as materials", click=ctrl.open_segmentation, classes="open-segmentation")
+                vuetify3.VBtn("Show as materials", click=(ctrl.open_segmentation, "[segmentation_path]"), classes="open-segmentation")
                 with Div(v_for="segment in segments", key="segment.id",
                          classes="d-flex flex-row align-center segment-row"):
                     vuetify3.VCheckboxBtn(model_value=("segment.visible",), density="compact",
