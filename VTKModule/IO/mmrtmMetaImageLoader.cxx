@@ -187,9 +187,10 @@ int MetaElementSize(const std::string& type)
 // slice: metaio formats each name with the pattern as a printf format and
 // divides by the step, which it computes as (max - min) / slices when it is
 // not given. So the pattern must hold exactly one integer conversion (%d,
-// %03d, ...) and nothing else printf reads, and the step must not be 0 or
-// lead away from max (a fuzz finding: a garbled ElementDataFile line
-// divided by zero).
+// %03d, ...) and nothing else printf reads, and the step must be positive
+// with max at least min: metaio counts up while the number is at most max,
+// so a step of 0 divided by zero and a negative one never ended (fuzz
+// findings: garbled ElementDataFile lines).
 void CheckMetaImageFilePattern(const std::string& path, const std::string& value, double slices)
 {
   std::istringstream in(value);
@@ -216,8 +217,8 @@ void CheckMetaImageFilePattern(const std::string& path, const std::string& value
   const double min = numbers.size() >= 1 ? numbers[0] : 1;
   const double max = numbers.size() >= 2 ? numbers[1] : min + slices - 1;
   const double step = numbers.size() >= 3 ? numbers[2] : numbers.size() == 2 ? std::trunc((max - min) / slices) : 1;
-  if (step == 0 || (max - min) / step < 0)
-    throw InputError(problem + "the step (" + std::to_string((long long)step) + ") does not go from " +
+  if (step <= 0 || max < min)
+    throw InputError(problem + "the step (" + std::to_string((long long)step) + ") does not count up from " +
       std::to_string((long long)min) + " to " + std::to_string((long long)max));
 }
 

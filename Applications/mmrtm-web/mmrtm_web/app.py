@@ -23,6 +23,18 @@ METHOD = "vtkMRMLMultiMaterialVolumeRenderingDisplayNode"
 # The methods the page offers: ours, and Slicer's CPU ray cast to compare.
 METHODS = {"Path tracing (MM-RTM)": METHOD, "Slicer's CPU ray cast": "vtkMRMLCPURayCastVolumeRenderingDisplayNode"}
 DEFAULT_PRESET = "CT-Bone"
+# The materials menu's first entry: the volume property translated, as
+# Volume Rendering's preset and the editor make it.
+VOLUME_PROPERTY_MATERIALS = "From the volume property"
+
+
+def material_presets():
+    """The project's MM-RTM material presets (ct-bone, mri, ...), which
+    replace the volume property's translation."""
+    from mmrtm import vtkMultiMaterialProperty
+
+    folder = vtkMultiMaterialProperty.GetPresetDirectory()
+    return sorted(f[:-len(".json")] for f in os.listdir(folder) if f.endswith(".json")) if os.path.isdir(folder) else []
 
 
 def parse_arguments(argv):
@@ -87,6 +99,8 @@ class WebViewer:
         state.trame__title = "mmrtm-web"
         state.presets = self.volume_rendering.preset_names()
         state.preset = preset if preset in state.presets else (state.presets[0] if state.presets else "")
+        state.material_presets = [VOLUME_PROPERTY_MATERIALS] + material_presets()
+        state.material_preset = VOLUME_PROPERTY_MATERIALS
         state.methods = list(METHODS)
         state.method = state.methods[0]
         state.studies = data_root.studies()
@@ -107,7 +121,7 @@ class WebViewer:
         state.change("method")(self.on_method)
         state.change("study")(self.on_study_chosen)
         state.change("shift")(self.on_shift)
-        state.change("samples_per_render", "maximum_samples", "noise_target")(self.on_sampling)
+        state.change("samples_per_render", "maximum_samples", "noise_target", "material_preset")(self.on_settings)
         state.change("upload")(self.on_upload)
         self.server.controller.open_study = self.on_open_study
         self.server.controller.open_segmentation = self.on_open_segmentation
@@ -191,6 +205,8 @@ class WebViewer:
             display.SetSamplesPerRender(max(1, int(state.samples_per_render)))
             display.SetMaximumSamples(max(1, int(state.maximum_samples)))
             display.SetNoiseTarget(max(0.0, min(1.0, float(state.noise_target) / 100)))
+            materials = state.material_preset
+            display.SetMaterialPreset(materials if materials in state.material_presets[1:] else "")
             if self.segmentation is not None:
                 display.SetAndObserveSegmentationNodeID(self.segmentation.GetID())
 
@@ -339,7 +355,8 @@ class WebViewer:
         if volume_property is not None and transfer_functions.set_colour_point(volume_property, index, colour):
             self.show_transfer_functions()
 
-    def on_sampling(self, **_):
+    def on_settings(self, **_):
+        """Samples per pass, maximum samples, noise target, materials."""
         display = self.display_node()
         if display is not None and display.IsA(METHOD):
             try:

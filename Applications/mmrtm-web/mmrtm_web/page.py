@@ -55,6 +55,9 @@ def build_page(server, layouts):
                 vuetify3.VSlider(v_model=("shift",), min=("shift_range[0]",), max=("shift_range[1]",),
                                  label="Shift", density="compact", hide_details=True, thumb_label=True,
                                  step=1, classes="shift-slider")
+                vuetify3.VSelect(v_model=("material_preset",), items=("material_presets",),
+                                 label="Materials (MM-RTM presets)", density="compact", hide_details=True,
+                                 classes="material-preset-select")
                 with vuetify3.VExpansionPanels(variant="accordion", classes="transfer-function-editor"):
                     with vuetify3.VExpansionPanel(title="Transfer functions"):
                         with vuetify3.VExpansionPanelText():

@@ -13,7 +13,9 @@ after a change is rendered in it, a fast preview during interaction) and
 the next pass runs on the tracer's threads. This scheduler then:
 
 - renders when the page or the scene asks (a camera move, a preset, a
-  resize): at once, between passes;
+  resize): at once, between passes; a change outside an interaction is
+  shown first as a preview (low resolution, tens of milliseconds), then
+  by its first full pass;
 - drops the requests made during its own render (the pipeline's "render
   again, not converged yet"), and instead watches the mappers: when the
   pass in flight has finished it renders once, which draws that pass and
@@ -129,13 +131,37 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         self._render_frame(self._interactive_quality)
         self.frames += 1
 
+    def interacting(self):
+        return self.render_window.GetDesiredUpdateRate() > self.render_window.GetInteractor().GetStillUpdateRate()
+
+    async def push_preview(self):
+        """A change outside an interaction (a preset, an edit, a resize)
+        shown first as an interaction's preview, which takes tens of
+        milliseconds, before the first full pass, which takes a second or
+        more on a CPU and holds the server meanwhile: the preview is sent
+        on its way before that pass starts."""
+        still = self.render_window.GetDesiredUpdateRate()
+        self.render_window.SetDesiredUpdateRate(self.render_window.GetInteractor().GetDesiredUpdateRate())
+        pushed = self._last_push_time_ms
+        try:
+            self.push_frame()
+        finally:
+            self.render_window.SetDesiredUpdateRate(still)
+        for _ in range(50):  # at most 0.25 s for its encoding and sending
+            await asyncio.sleep(0.005)
+            if self._last_push_time_ms != pushed:
+                break
+
     async def _render(self):
         while await self._next_render():
             requested = self._request_event.is_set()
             self._request_event.clear()
             mappers = self.mappers()
             before = self.progress(mappers)
-            if not requested and before == self.pushed:
+            changed = requested and mappers and not self.interacting()
+            if changed:
+                await self.push_preview()
+            elif not requested and before == self.pushed:
                 # Asked by nothing: a pass has ended, or a change's first
                 # pass was drawn and this render only starts the next one
                 # in the background. Only a render that drew new samples
@@ -156,7 +182,8 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
             # change of mode: after an interaction's preview (no samples
             # accumulate), or after a render that was not asked for and
             # neither drew samples nor started a pass.
-            preview = mappers and not any(after[0])
+            # A change's preview is followed by its first pass.
+            preview = mappers and not any(after[0]) and not changed
             idle = not any(m.IsRefining() for m in mappers)
             self.stalled_at = after if idle and (preview or (not requested and after == before)) else None
             if self.on_frame is not None:
