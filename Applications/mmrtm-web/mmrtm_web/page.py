@@ -46,7 +46,7 @@ def build_page(server, layouts):
                 # still wait behind a render when the click arrives.
                 vuetify3.VBtn("Open", click=(ctrl.open_study, "[study, series_items.length ? series : null]"),
                               classes="open-study")
-                vuetify3.VFileInput(label="Upload (NRRD, NIfTI, MetaImage .mha)", density="compact",
+                vuetify3.VFileInput(label="Upload (NRRD, NIfTI, .mha, .inv3)", density="compact",
                                     hide_details=True, show_size=True, classes="upload-input",
                                     update_modelValue=UPLOAD_CHECK)
                 html.Div("Look", classes="text-subtitle-2 mt-2")
