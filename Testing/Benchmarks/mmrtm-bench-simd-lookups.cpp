@@ -34,6 +34,7 @@
 
 #include "mmrtm/tracking.h"
 #include "mmrtmVolumeLoader.h"
+#include "plain_ct_bone_scene.h"
 #include "plain_extinction.h"
 #include "scene_json.h"
 #include "simd_targets.h"
@@ -177,12 +178,7 @@ int main(int argc, char** argv) {
       volume = argv[i];
   }
   try {
-    mmrtm::SceneInputs inputs;
-    inputs.volumes["scalars"] = mmrtm::LoadVolume(volume, "scalars");
-    nlohmann::json doc = mmrtm::ReadJsonFile(std::string(MMRTM_DATA_DIR) + "/presets/ct-bone.json");
-    doc["render"]["width"] = size;
-    doc["render"]["height"] = size;
-    mmrtm::Scene scene = mmrtm::SceneFromJson(doc, std::move(inputs));
+    mmrtm::Scene scene = PlainCtBoneScene(volume, size);
     mmrtm::SceneView view = scene.Build();
     if (!view.classifier.plain) {
       std::fprintf(stderr, "mmrtm-bench-simd-lookups: the scene is not plain\n");
