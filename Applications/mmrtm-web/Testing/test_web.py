@@ -411,6 +411,19 @@ class WebViewerTest(unittest.TestCase):
             time.sleep(0.1)
         self.fail("not converged within %.0f s: %s" % (timeout, self.status()))
 
+    def show_converged(self, study, preset):
+        """Opens the page and `study` with `preset`, and waits for its
+        refinement to end. The preset comes first, which the study then
+        opens with: the study's frames are new whatever preset was shown
+        (a preset already shown would give none to wait for, and the
+        toolbar says converged of the image before until they come)."""
+        self.open_page()
+        self.frame(60)
+        self.choose("preset-select", preset)
+        frames = self.frames_rendered()
+        self.assertEqual(self.open_study(study), "")
+        self.wait_converged(frames)
+
     def test_d_refinement_streams_a_frame_a_pass_and_a_drag_previews_at_once(self):
         """A restart (a preset) shows its preview, then refines to the
         maximum samples with one frame rendered and received per sample
@@ -422,11 +435,7 @@ class WebViewerTest(unittest.TestCase):
         that misses passes, a render loop that blocks the server during
         refinement (the drag would wait for it), and previews that are
         too slow to follow the mouse."""
-        self.open_page()
-        self.frame(60)
-        self.assertEqual(self.open_study("ct_head_cranium.nrrd"), "")
-        self.choose("preset-select", "CT-Bone")
-        self.wait_converged()
+        self.show_converged("ct_head_cranium.nrrd", "CT-Bone")
         time.sleep(1)
         frames, loads = self.frames_rendered(), len(self.view_loads())
         self.choose("preset-select", "CT-Muscle")
@@ -597,11 +606,7 @@ class WebViewerTest(unittest.TestCase):
         colour point changed recolours it. Catches an editor that shows
         points but edits nothing, or edits another property than the one
         rendered."""
-        self.open_page()
-        self.frame(60)
-        self.assertEqual(self.open_study("ct_head_cranium.nrrd"), "")
-        self.choose("preset-select", "CT-Muscle")
-        self.wait_converged()
+        self.show_converged("ct_head_cranium.nrrd", "CT-Muscle")
         kept = self.frame(5, keep=True)
         self.browser.find_element("css selector", ".transfer-function-editor .v-expansion-panel-title").click()
         time.sleep(1)
@@ -633,11 +638,7 @@ class WebViewerTest(unittest.TestCase):
         chosen again gives the first image back. Catches a menu that does
         not reach the display node, and a preset that stays after it is
         left."""
-        self.open_page()
-        self.frame(60)
-        self.assertEqual(self.open_study("ct_head_cranium.nrrd"), "")
-        self.choose("preset-select", "CT-Bone")
-        self.wait_converged()
+        self.show_converged("ct_head_cranium.nrrd", "CT-Bone")
         self.frame(5, keep=True)
         first = self.browser.execute_script(FRAME_MASK)
         frames = self.frames_rendered()

@@ -115,7 +115,7 @@ class WebViewer:
         state.opacity_points, state.colour_points = [], []
         state.segmentation_path = ""
         state.segments = []
-        state.upload_limit = int(upload_limit_mb * 1024 * 1024)
+        state.upload_limit = self.studies.upload_limit
         state.upload = None
         state.change("preset")(self.on_preset)
         state.change("method")(self.on_method)

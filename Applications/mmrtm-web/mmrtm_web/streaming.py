@@ -139,7 +139,9 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         shown first as an interaction's preview, which takes tens of
         milliseconds, before the first full pass, which takes a second or
         more on a CPU and holds the server meanwhile: the preview is sent
-        on its way before that pass starts."""
+        on its way before that pass starts. (A request that changed
+        nothing would stop the pass in flight for nothing; none is seen:
+        hovering over the views asks for no render.)"""
         still = self.render_window.GetDesiredUpdateRate()
         self.render_window.SetDesiredUpdateRate(self.render_window.GetInteractor().GetDesiredUpdateRate())
         pushed = self._last_push_time_ms
