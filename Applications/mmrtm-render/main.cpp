@@ -77,6 +77,9 @@ options:
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
                         cpu, or cuda (an error without a CUDA device)
+  --simd M              the CPU's: auto (SIMD lanes where this build and CPU have
+                        them; default) or off (the scalar tracker, for comparison;
+                        the same image)
   --estimator E         delta (unbiased, default) or raymarch (biased baseline)
   --accelerator A       majorants for delta tracking: none (one global majorant),
                         macrocell (uniform grid), octree (default: the hierarchical
@@ -130,6 +133,7 @@ struct Options {
                                                                 outputVariance, statsJson, denoisedPreview;
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
+  mmrtm::SimdMode simd = mmrtm::SimdMode::Auto;
   bool quiet = false, listSeries = false;
   double noiseTarget = 0;     // 0: render all --spp samples
   bool adaptive = false;      // --sampling adaptive
@@ -208,6 +212,11 @@ Options ParseArguments(int argc, char** argv) {
       const auto backend = mmrtm::ParseBackend(b);
       if (!backend) UsageError("--backend expects auto, cpu or cuda, got '" + b + "'");
       o.backend = *backend;
+    } else if (a == "--simd") {
+      const std::string m = value();
+      const auto simd = mmrtm::ParseSimdMode(m);
+      if (!simd) UsageError("--simd expects auto or off, got '" + m + "'");
+      o.simd = *simd;
     } else if (a == "--max-bounces")
       o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);
     else if (a == "--shadow-scale")
@@ -515,7 +524,7 @@ int Run(const Options& o) {
   const auto note = [&](const std::string& text) {
     if (!o.quiet) std::fprintf(stderr, "note: %s\n", text.c_str());
   };
-  std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note);
+  std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note, o.simd);
   mmrtm::Film film(rs.width, rs.height);
   mmrtm::TraceCounters counters;
   if (!o.quiet)

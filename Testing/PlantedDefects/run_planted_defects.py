@@ -31,6 +31,7 @@ from pathlib import Path
 # VTK (headless). Measured: no defect passes them in about 40 s.
 CHECKS = [
     ("TestTransferFunctions", "TestTransferFunctions", [], False),
+    ("TestSimdBackend", "TestSimdBackend", [], False),
     ("TestAdaptiveSampling AdaptiveFilm", "TestAdaptiveSampling", ["--gtest_filter=AdaptiveFilm.*"], False),
     ("TestBSDF lobes and phase", "TestBSDF",
      ["--gtest_filter=BSDF.EachLobesAlbedoIsItsIntegral:BSDF.SampledAlbedoIsTheIntegral:Phase.*"], False),
@@ -45,7 +46,7 @@ CHECKS = [
 
 DEFECTS = ["volume_albedo", "diffuse_lobe", "specular_lobe", "phase_sign", "majorant_low", "minorant_high",
            "shadow_last_segment", "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-           "film_variance"]
+           "film_variance", "simd_extinction"]
 
 
 def configure_and_build(source, build):

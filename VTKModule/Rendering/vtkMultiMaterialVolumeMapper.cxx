@@ -138,7 +138,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
 {
   mmrtm::Scene Scene;
   std::unique_ptr<mmrtm::Renderer> Renderer;
-  int RendererBackend = -1, RendererThreads = -1;
+  int RendererBackend = -1, RendererThreads = -1, RendererCpuSimd = -1;
   std::unique_ptr<mmrtm::Film> Film;
   std::string BackendDescription;
   vtkNew<vtkMatrix4x4> Matrix; // the volume's matrix at the last render
@@ -519,6 +519,13 @@ void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
     this->DisplayEdit([&] { this->ToneMapping = mode; });
 }
 
+void vtkMultiMaterialVolumeMapper::SetCpuSimd(vtkTypeBool simd)
+{
+  simd = simd ? 1 : 0;
+  if (simd != this->CpuSimd)
+    this->DisplayEdit([&] { this->CpuSimd = simd; });
+}
+
 void vtkMultiMaterialVolumeMapper::SetLookToVTK()
 {
   this->SetToneMappingToAutomatic();
@@ -545,7 +552,8 @@ void vtkMultiMaterialVolumeMapper::DisplayEdit(Edit edit)
 vtkMTimeType vtkMultiMaterialVolumeMapper::TracingMTime()
 {
   // The mapper's modification time as far as tracing goes: a display edit
-  // (exposure, tone mapping: only DrawFilm reads them) with nothing
+  // (exposure, tone mapping: only DrawFilm reads them; the CPU's SIMD
+  // switch: the same film either way) with nothing
   // modified after it leaves the time it had before, so the accumulation
   // goes on.
   const vtkMTimeType t = this->GetMTime();
@@ -1261,15 +1269,18 @@ mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProp
 void vtkMultiMaterialVolumeMapper::UpdateRenderer()
 {
   Internals& in = *this->Internal;
-  if (in.Renderer && in.RendererBackend == this->Backend && in.RendererThreads == this->NumberOfThreads)
+  if (in.Renderer && in.RendererBackend == this->Backend && in.RendererThreads == this->NumberOfThreads &&
+    in.RendererCpuSimd == this->CpuSimd)
     return;
   const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
     : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
                                                       : mmrtm::Backend::Auto;
-  in.Renderer =
-    mmrtm::MakeRenderer(backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); });
+  in.Renderer = mmrtm::MakeRenderer(
+    backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); },
+    this->CpuSimd ? mmrtm::SimdMode::Auto : mmrtm::SimdMode::Off);
   in.RendererBackend = this->Backend;
   in.RendererThreads = this->NumberOfThreads;
+  in.RendererCpuSimd = this->CpuSimd;
   in.BackendDescription = in.Renderer->Description();
 }
 
@@ -1689,6 +1700,7 @@ void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "Backend: " << this->Backend << "\n";
+  os << indent << "CpuSimd: " << this->CpuSimd << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "ShadowExtinctionScale: " << this->ShadowExtinctionScale << "\n";
   os << indent << "NoiseTarget: " << this->NoiseTarget << "\n";

@@ -136,6 +136,18 @@ public:
   void SetBackendToCUDA() { this->SetBackend(CUDA); }
   ///@}
 
+  ///@{
+  /**
+   * On the CPU, trace in SIMD lanes where this build and CPU have them (on,
+   * the default), or with the scalar tracker (off, for comparison: the
+   * same image to the last bit, so the accumulation goes on). mmrtm-render's
+   * --simd auto|off.
+   */
+  virtual void SetCpuSimd(vtkTypeBool simd);
+  vtkGetMacro(CpuSimd, vtkTypeBool);
+  vtkBooleanMacro(CpuSimd, vtkTypeBool);
+  ///@}
+
   enum Accelerators
   {
     OCTREE = 0,
@@ -538,6 +550,7 @@ protected:
   int Seed = 0;
   int NumberOfThreads = 0;
   int Backend = AUTO;
+  vtkTypeBool CpuSimd = 1;
   double Exposure = 1.0;
   int ToneMapping = AUTOMATIC_TONE_MAPPING;
   vtkTypeBool UnshadedScattering = 0;

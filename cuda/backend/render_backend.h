@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cpu_renderer.h"
 #include "film.h"
 #include "mmrtm/counters.h"
 #include "scene.h"
@@ -60,8 +61,9 @@ class Renderer {
 
 // `note` receives one-line remarks for the user (why auto chose the CPU, a
 // fall-back after a GPU allocation failed). Throws BackendError for an
-// explicit `cuda` that cannot run.
+// explicit `cuda` that cannot run. `simd`: the CPU's (cpu_renderer.h).
 std::unique_ptr<Renderer> MakeRenderer(Backend backend, int threads,
-                                       const std::function<void(const std::string&)>& note = nullptr);
+                                       const std::function<void(const std::string&)>& note = nullptr,
+                                       SimdMode simd = SimdMode::Auto);
 
 }  // namespace mmrtm

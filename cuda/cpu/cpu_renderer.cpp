@@ -10,11 +10,28 @@
 
 #include "mmrtm/integrator.h"
 #include "cpu_projection.h"
+#include "wavefront_tile.h"
 
 namespace mmrtm {
 
-CpuRenderer::CpuRenderer(int threads)
-    : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())) {}
+std::optional<SimdMode> ParseSimdMode(const std::string& name) {
+  if (name == "off") return SimdMode::Off;
+  if (name == "auto") return SimdMode::Auto;
+  return std::nullopt;
+}
+
+CpuRenderer::CpuRenderer(int threads, SimdMode simd)
+    : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())), simd_(simd) {}
+
+bool CpuRenderer::UsesSimd(const SceneView& scene) const {
+  return simd_ == SimdMode::Auto && SimdLookupsBuilt() && scene.settings.estimator == Estimator::DeltaTracking &&
+         scene.settings.projection.mode == IntensityProjection::None;
+}
+
+std::string CpuRenderer::Description() const {
+  std::string d = "cpu, " + std::to_string(threads_) + " thread(s), ";
+  return d + (simd_ == SimdMode::Auto && SimdLookupsBuilt() ? std::string("SIMD ") + SimdLookupTarget() : "scalar");
+}
 
 bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,
                          const Progress& progress, const std::atomic<bool>* cancel) const {
@@ -56,31 +73,38 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   std::mutex progressMutex;
   int tilesDone = 0;
   std::vector<TraceCounters> perThread(threads_);
+  std::vector<LaneCounters> lanesPerThread(threads_);
 
   const bool projecting = s.settings.projection.mode != IntensityProjection::None;  // mmrtm/projection.h
+  const bool wavefront = UsesSimd(s);
   auto worker = [&](int thread) {
     TraceCounters& ctr = perThread[thread];
+    WavefrontTile wavefrontTile;
     for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
       if (cancel && cancel->load(std::memory_order_relaxed)) break;
       const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
       const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-          const uint32_t first = film.PixelSamples(x, y), last = end((size_t)y * width + x, first);
-          if (projecting) {
+      if (wavefront) {
+        wavefrontTile.Render(s, film, view, x0, y0, x1, y1, end, ctr, &lanesPerThread[thread]);
+      } else {
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) {
+            const uint32_t first = film.PixelSamples(x, y), last = end((size_t)y * width + x, first);
+            if (projecting) {
+              for (uint32_t index = first; index < last; ++index) {
+                const PixelSample ps = ProjectPixelOnCpu(s, x, y, ctr);
+                view.AddSample(x, y, ps.L, ps.alpha, index + 1);
+              }
+              continue;
+            }
+            const uint64_t workBefore = ctr.Work();
             for (uint32_t index = first; index < last; ++index) {
-              const PixelSample ps = ProjectPixelOnCpu(s, x, y, ctr);
+              PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
               view.AddSample(x, y, ps.L, ps.alpha, index + 1);
             }
-            continue;
+            view.AddWork(x, y, (float)(ctr.Work() - workBefore));
           }
-          const uint64_t workBefore = ctr.Work();
-          for (uint32_t index = first; index < last; ++index) {
-            PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
-            view.AddSample(x, y, ps.L, ps.alpha, index + 1);
-          }
-          view.AddWork(x, y, (float)(ctr.Work() - workBefore));
-        }
+      }
       if (progress) {
         std::lock_guard<std::mutex> lock(progressMutex);
         progress(++tilesDone, tileCount);
@@ -96,6 +120,8 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   if (cancel && cancel->load()) return false;
   if (counters)
     for (const TraceCounters& c : perThread) *counters += c;
+  if (lanes_)
+    for (const LaneCounters& l : lanesPerThread) *lanes_ += l;
   return true;
 }
 

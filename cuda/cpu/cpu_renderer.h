@@ -6,19 +6,37 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "film.h"
 #include "mmrtm/counters.h"
 #include "mmrtm/scene_view.h"
+#include "wavefront_camera_paths.h"
 
 namespace mmrtm {
+
+// --simd off|auto. Auto: the SIMD backend where it runs (a build with
+// Highway, delta tracking, no intensity projection): a tile's camera rays
+// tracked together with their lookups in SIMD lanes
+// (wavefront_camera_paths.h). Off: the scalar backend, for comparison.
+// Both give the same image to the last bit.
+enum class SimdMode { Off, Auto };
+std::optional<SimdMode> ParseSimdMode(const std::string& name);
 
 class CpuRenderer {
  public:
   // threads <= 0: one per hardware thread.
-  explicit CpuRenderer(int threads = 0);
+  explicit CpuRenderer(int threads = 0, SimdMode simd = SimdMode::Auto);
   int Threads() const { return threads_; }
+  SimdMode Simd() const { return simd_; }
+  // Whether a render of `scene` runs the SIMD backend.
+  bool UsesSimd(const SceneView& scene) const;
+  // "cpu, 2 thread(s), SIMD AVX3" (or "scalar").
+  std::string Description() const;
+  // Where the renders that follow add their lanes' occupancy (null: not counted).
+  void CountLanes(LaneCounters* lanes) { lanes_ = lanes; }
 
   // Called with (tiles done, tiles total) as tiles finish, from one thread at a time.
   using Progress = std::function<void(int, int)>;
@@ -46,6 +64,8 @@ class CpuRenderer {
   bool RenderRanges(const SceneView& scene, Film& film, const std::function<uint32_t(size_t, uint32_t)>& end,
                     TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) const;
   int threads_;
+  SimdMode simd_;
+  LaneCounters* lanes_ = nullptr;
 };
 
 }  // namespace mmrtm

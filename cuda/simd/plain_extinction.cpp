@@ -4,6 +4,8 @@
 // does and the results are the same bits.
 #include "plain_extinction.h"
 
+#include "mmrtm/planted_defect.h"
+
 #include <cstring>
 
 #undef HWY_TARGET_INCLUDE
@@ -163,6 +165,7 @@ HWY_FLATTEN void PlainExtinctionLanes(const Classifier& classifier, const float*
 }
 
 const char* TargetNameLanes() { return hwy::TargetName(HWY_TARGET); }
+size_t LaneCountLanes() { return hn::Lanes(DF()); }
 
 }  // namespace HWY_NAMESPACE
 }  // namespace mmrtm
@@ -173,6 +176,7 @@ namespace mmrtm {
 
 HWY_EXPORT(PlainExtinctionLanes);
 HWY_EXPORT(TargetNameLanes);
+HWY_EXPORT(LaneCountLanes);
 
 void PlainExtinctionSimd(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
                          float* sigma_t) {
@@ -183,6 +187,8 @@ void PlainExtinctionSimd(const Classifier& classifier, const float* x, const flo
   // bytes of the buffer.
   if (bytes < 4 || bytes >= ((int64_t)1 << 31)) return PlainExtinctionScalar(classifier, x, y, z, count, sigma_t);
   HWY_DYNAMIC_DISPATCH(PlainExtinctionLanes)(classifier, x, y, z, count, sigma_t);
+  if (Planted(Defect::SimdExtinction))
+    for (size_t i = 0; i < count; ++i) sigma_t[i] *= 0.98f;
 }
 
 void PlainExtinctionScalar(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
@@ -196,6 +202,7 @@ void PlainExtinctionScalar(const Classifier& classifier, const float* x, const f
 }
 
 const char* PlainExtinctionTarget() { return HWY_DYNAMIC_DISPATCH(TargetNameLanes)(); }
+size_t PlainExtinctionLaneCount() { return HWY_DYNAMIC_DISPATCH(LaneCountLanes)(); }
 
 }  // namespace mmrtm
 #endif  // HWY_ONCE

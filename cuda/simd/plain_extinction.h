@@ -30,7 +30,9 @@ void PlainExtinctionSimd(const Classifier& classifier, const float* x, const flo
 void PlainExtinctionScalar(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
                            float* sigma_t);
 
-// The Highway target that PlainExtinctionSimd runs on now ("AVX3", "AVX2", ...).
+// The Highway target that PlainExtinctionSimd runs on now ("AVX3", "AVX2", ...),
+// and its number of float lanes.
 const char* PlainExtinctionTarget();
+size_t PlainExtinctionLaneCount();
 
 }  // namespace mmrtm

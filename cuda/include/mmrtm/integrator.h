@@ -59,8 +59,12 @@ MMRTM_CPU_GPU inline bool ChooseAndReuse(float p, float* u) {
 // application in front, e.g. a VTK mesh); beyond it the pixel is not the
 // volume's and nothing (not even the environment) is seen.
 // `pairs`, when given, supplies the first vertices' numbers.
+// `cameraFreePath`, when given, is the camera ray's free path, sampled
+// already with `rng` (the CPU's SIMD backend tracks many camera rays at
+// once: cpu/wavefront_camera_paths.h); rng is then where that left it.
 MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, TraceCounters& ctr,
-                                    float cameraTMax = kInfinity, const SobolPairs* pairs = nullptr) {
+                                    float cameraTMax = kInfinity, const SobolPairs* pairs = nullptr,
+                                    const FreePathResult* cameraFreePath = nullptr) {
   PixelSample out;
   RGB beta(1.f);
   float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
@@ -77,10 +81,14 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     // This vertex's low-discrepancy pairs, or none (then rng).
     const SobolPairs* ld = depth < kSobolVertices ? pairs : nullptr;
     const int pairBase = kPairFirstVertex + depth * kPairsPerVertex;
-    float ldFreePath[2];
-    if (ld) ld->Get(pairBase + kPairFreePath, &ldFreePath[0], &ldFreePath[1]);
-    FreePathResult fp =
-        SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr, ld ? ldFreePath : nullptr);
+    FreePathResult fp;
+    if (depth == 0 && cameraFreePath) {
+      fp = *cameraFreePath;
+    } else {
+      float ldFreePath[2];
+      if (ld) ld->Get(pairBase + kPairFreePath, &ldFreePath[0], &ldFreePath[1]);
+      fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr, ld ? ldFreePath : nullptr);
+    }
     if (!fp.collided) {
       if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
@@ -220,30 +228,50 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
   return out;
 }
 
-// One sample of pixel (x, y): its own random stream (DESIGN.md rule 2), a
-// box-filtered position in the pixel, a lens position, and the path; with
-// the Sobol' sampler the position, the lens and the first vertices' numbers
-// are Owen-scrambled Sobol' pairs of the same (seed, pixel, sample index).
+// The start of one sample of pixel (x, y): its own random stream (DESIGN.md
+// rule 2), a box-filtered position in the pixel, a lens position and the
+// camera ray; with the Sobol' sampler the position, the lens and the first
+// vertices' numbers are Owen-scrambled Sobol' pairs of the same (seed,
+// pixel, sample index).
+struct CameraSample {
+  PCG32 rng;
+  SobolPairs pairs;
+  bool sobol;
+  Ray ray;
+  float tMax;  // Li's cameraTMax
+
+  MMRTM_CPU_GPU CameraSample(const SceneView& s, int x, int y, uint32_t sampleIndex)
+      : rng(PixelSampleRNG(s.settings.seed, (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y, sampleIndex)),
+        pairs(s.settings.seed, (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y, sampleIndex),
+        sobol(s.settings.sampler == PixelSampler::Sobol) {
+    float fx, fy, l0 = 0.f, l1 = 0.f;
+    if (sobol) {
+      pairs.Get(kPairPixel, &fx, &fy);
+      if (s.camera.lensRadius > 0.f) pairs.Get(kPairLens, &l0, &l1);
+    } else {
+      fx = rng.Uniform();
+      fy = rng.Uniform();
+      l0 = rng.Uniform();
+      l1 = rng.Uniform();
+    }
+    ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
+    tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
+  }
+  MMRTM_CPU_GPU const SobolPairs* Pairs() const { return sobol ? &pairs : nullptr; }
+  // The camera vertex's pair of the free path (its first arrival and its
+  // real-or-null choice), or negatives (drawn from rng).
+  MMRTM_CPU_GPU void FreePathPair(float* u0, float* u1) const {
+    *u0 = *u1 = -1.f;
+    if (sobol) pairs.Get(kPairFirstVertex + kPairFreePath, u0, u1);
+  }
+};
+
+// One sample of pixel (x, y).
 MMRTM_CPU_GPU inline PixelSample RenderPixelSample(const SceneView& s, int x, int y, uint32_t sampleIndex,
                                                    TraceCounters& ctr) {
-  const uint64_t pixel = (uint64_t)x + (uint64_t)s.camera.width * (uint64_t)y;
-  PCG32 rng = PixelSampleRNG(s.settings.seed, pixel, sampleIndex);
-  float fx, fy, l0 = 0.f, l1 = 0.f;
-  const bool sobol = s.settings.sampler == PixelSampler::Sobol;
-  const SobolPairs pairs(s.settings.seed, pixel, sampleIndex);
-  if (sobol) {
-    pairs.Get(kPairPixel, &fx, &fy);
-    if (s.camera.lensRadius > 0.f) pairs.Get(kPairLens, &l0, &l1);
-  } else {
-    fx = rng.Uniform();
-    fy = rng.Uniform();
-    l0 = rng.Uniform();
-    l1 = rng.Uniform();
-  }
-  Ray ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
+  CameraSample cs(s, x, y, sampleIndex);
   ++ctr.paths;
-  const float tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
-  return Li(s, ray, rng, ctr, tMax, sobol ? &pairs : nullptr);
+  return Li(s, cs.ray, cs.rng, ctr, cs.tMax, cs.Pairs());
 }
 
 }  // namespace mmrtm

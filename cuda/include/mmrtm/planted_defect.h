@@ -35,6 +35,7 @@ enum class Defect : uint8_t {
   MapperColorRefit,   // the VTK mapper does not refit after a colour-function edit
   LabelSwap,          // label materials 1 and 2 swapped
   FilmVariance,       // the film's variance of the mean halved
+  SimdExtinction,     // the SIMD lanes' extinction x0.98 (the scalar lookups untouched)
   Count
 };
 
@@ -43,7 +44,7 @@ inline const char* DefectName(Defect d) {
   static const char* const names[] = {"none",          "volume_albedo",   "diffuse_lobe",       "specular_lobe",
                                       "phase_sign",    "majorant_low",    "minorant_high",      "shadow_last_segment",
                                       "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-                                      "film_variance"};
+                                      "film_variance", "simd_extinction"};
   static_assert(sizeof(names) / sizeof(names[0]) == (size_t)Defect::Count, "a name per defect");
   return names[(int)d];
 }

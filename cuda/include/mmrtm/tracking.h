@@ -36,18 +36,25 @@ struct FreePathResult {
 // Classifies p (`index0`: p in proxy 0's index space), counting the lookup,
 // and a violation if the (scaled) extinction there exceeds the majorant that
 // the tracker was given.
+MMRTM_CPU_GPU inline void CountLookup(float sigma_t, float sigma_maj, float scale, TraceCounters& ctr) {
+  ++ctr.densityLookups;
+  if (scale * sigma_t > sigma_maj * 1.0001f) ++ctr.majorantViolations;
+}
 MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, Vec3 index0, float sigma_maj,
                                                    float scale, TraceCounters& ctr) {
   Classification c = s.classifier.Classify(p, index0);
-  ++ctr.densityLookups;
-  if (scale * c.sigma_t > sigma_maj * 1.0001f) ++ctr.majorantViolations;
+  CountLookup(c.sigma_t, sigma_maj, scale, ctr);
   return c;
 }
 
-// Walks the tentative collisions of a ray up to tMax: the arrivals of a
-// Poisson process whose rate is each majorant segment's sigma_maj. Calls
-// visit(t, classification, sigma_maj) at each until visit returns false or
-// the ray ends. `scale` multiplies the extinction and the majorants.
+// A walk over the tentative collisions of a ray up to tMax: the arrivals of
+// a Poisson process whose rate is each majorant segment's sigma_maj
+// (`scale` multiplies the extinction and the majorants). Its state is kept
+// between arrivals, so that a caller can stop at each to look the
+// extinction up: SampleTentativeCollisions looks up at once, the CPU's SIMD
+// backend gathers many walks' arrivals into one lookup in lanes
+// (cpu/wavefront_camera_paths.h). Both draw the same random numbers in the
+// same order per path.
 //
 // The optical depth to the next arrival is drawn once, Exp(1), and what a
 // segment does not use up carries into the next (pbrt-v4's SampleT_maj
@@ -55,76 +62,144 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, V
 // also allows). The same distribution; but a segment without a collision
 // costs a multiply and a compare instead of a random number and a logf, and
 // an octree walk hands out about two segments per lookup.
-// `uFirst`, when in [0, 1), is the uniform of the first arrival (a
-// low-discrepancy number); otherwise it is drawn from rng.
 //
-// segment(seg) is called first for every segment; false ends the walk.
 // With `Residual` the arrivals' rate is sigma_maj - sigma_min instead (the
 // residual of residual ratio tracking, which takes the control part,
-// exp(-sigma_min * length), in segment), and visit gets (classification,
-// residual segment), whose sigma_maj is that rate.
+// exp(-sigma_min * length), in Next's `segment`).
+template <bool Residual>
+class TentativeCollisionWalk {
+ public:
+  // The walk of `ray` over the domain (empty where the ray misses it).
+  // Built in place: a copy of the grid walk's state costs about 55
+  // instructions (mmrtm/majorant.h).
+  MMRTM_CPU_GPU TentativeCollisionWalk(const SceneView& s, const Ray& ray, float tMax, float scale)
+      : inDomain_(s.DomainInterval(ray, tMax, &indexRay_, &t0_, &t1_)),
+        it_(inDomain_ ? s.majorants.Begin(indexRay_, t0_, t1_, scale) : MajorantIterator()) {}
+
+  MMRTM_CPU_GPU bool InDomain() const { return inDomain_; }
+  // Draws the optical depth to the first arrival: `uFirst` when in [0, 1)
+  // (a low-discrepancy number), otherwise from rng. Only for a walk in
+  // the domain, before the first Next.
+  MMRTM_CPU_GPU void Start(PCG32& rng, float uFirst) { tau_ = -logf(1.f - (uFirst >= 0.f ? uFirst : rng.Uniform())); }
+  // After an arrival that did not end the walk: the optical depth to the next.
+  MMRTM_CPU_GPU void DrawNextArrival(PCG32& rng) { tau_ = -logf(1.f - rng.Uniform()); }
+
+  // Advances to the next arrival, false at the end of the ray.
+  // segment(seg) is called first for every segment (Residual only); false
+  // ends the walk.
+  template <typename OnSegment>
+  MMRTM_INLINE MMRTM_CPU_GPU bool Next(TraceCounters& ctr, OnSegment segment) {
+    for (;;) {
+      if (!inSegment_) {
+        if (!it_.Next(&seg_)) return false;
+        ++ctr.majorantSegments;
+        if constexpr (Residual) {
+          if (Planted(Defect::ShadowLastSegment) && seg_.tMax >= t1_) return false;
+          if (!segment(seg_)) return false;
+          seg_.sigma_maj -= seg_.sigma_min;
+        }
+        if (seg_.sigma_maj <= 0.f) continue;
+        t_ = seg_.tMin;
+        inSegment_ = true;
+      }
+      const float tauLeft = (seg_.tMax - t_) * seg_.sigma_maj;  // in this segment
+      if (tau_ >= tauLeft) {
+        tau_ -= tauLeft;
+        inSegment_ = false;
+        continue;
+      }
+      t_ += tau_ / seg_.sigma_maj;  // below tMax but for rounding, which lands on this node's face
+      return true;
+    }
+  }
+  MMRTM_INLINE MMRTM_CPU_GPU bool Next(TraceCounters& ctr) {
+    return Next(ctr, [](const RayMajorantSegment&) { return true; });
+  }
+
+  // The arrival's distance along the ray.
+  MMRTM_CPU_GPU float T() const { return t_; }
+  // The arrival also in proxy 0's index space: the proxies on proxy 0's
+  // grid are sampled there (Classifier::onProxy0Grid).
+  MMRTM_CPU_GPU Vec3 IndexPoint() const { return indexRay_(t_); }
+  // The segment of the arrival; with Residual, its sigma_maj is the
+  // residual rate.
+  MMRTM_CPU_GPU const RayMajorantSegment& Segment() const { return seg_; }
+  // The bound the (scaled) extinction at the arrival must keep.
+  MMRTM_CPU_GPU float Majorant() const { return Residual ? seg_.sigma_maj + seg_.sigma_min : seg_.sigma_maj; }
+
+ private:
+  Ray indexRay_;
+  float t0_, t1_;
+  bool inDomain_;
+  MajorantIterator it_;
+  RayMajorantSegment seg_;
+  float t_ = 0.f;
+  float tau_ = 0.f;  // optical depth to the next arrival
+  bool inSegment_ = false;
+};
+
+// Walks the tentative collisions of a ray up to tMax (TentativeCollisionWalk)
+// and calls visit(t, classification, sigma_maj) at each until visit returns
+// false or the ray ends. `uFirst` as in TentativeCollisionWalk::Start.
+// With `Residual`, segment(seg) is called first for every segment, and
+// visit gets (classification, residual segment), whose sigma_maj is the
+// residual rate.
 template <bool Residual = false, typename Visit, typename Segment>
 MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
                                                     PCG32& rng, TraceCounters& ctr, Visit visit, Segment segment,
                                                     float uFirst = -1.f) {
-  Ray indexRay;
-  float t0, t1;
-  if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
-  MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, scale);
-  RayMajorantSegment seg;
-  float tau = -logf(1.f - (uFirst >= 0.f ? uFirst : rng.Uniform()));  // optical depth to the next arrival
-  while (it.Next(&seg)) {
-    ++ctr.majorantSegments;
+  TentativeCollisionWalk<Residual> walk(s, ray, tMax, scale);
+  if (!walk.InDomain()) return;
+  walk.Start(rng, uFirst);
+  while (walk.Next(ctr, segment)) {
+    const Classification c = LookupAndCount(s, ray(walk.T()), walk.IndexPoint(), walk.Majorant(), scale, ctr);
     if constexpr (Residual) {
-      if (Planted(Defect::ShadowLastSegment) && seg.tMax >= t1) return;
-      if (!segment(seg)) return;
-      seg.sigma_maj -= seg.sigma_min;
+      if (!visit(c, walk.Segment())) return;
+    } else {
+      if (!visit(walk.T(), c, walk.Segment().sigma_maj)) return;
     }
-    if (seg.sigma_maj <= 0.f) continue;
-    for (float t = seg.tMin;;) {
-      const float tauLeft = (seg.tMax - t) * seg.sigma_maj;  // in this segment
-      if (tau >= tauLeft) {
-        tau -= tauLeft;
-        break;
-      }
-      t += tau / seg.sigma_maj;  // below tMax but for rounding, which lands on this node's face
-      // The point also in proxy 0's index space, from the index ray: the
-      // proxies on proxy 0's grid are sampled there (Classifier::onProxy0Grid).
-      Classification c =
-          LookupAndCount(s, ray(t), indexRay(t), Residual ? seg.sigma_maj + seg.sigma_min : seg.sigma_maj, scale, ctr);
-      if constexpr (Residual) {
-        if (!visit(c, seg)) return;
-      } else {
-        if (!visit(t, c, seg.sigma_maj)) return;
-      }
-      tau = -logf(1.f - rng.Uniform());
-    }
+    walk.DrawNextArrival(rng);
   }
 }
 
-// Delta tracking: a tentative collision is real with probability
-// sigma_t / sigma_maj. `first`, when given, holds the uniforms of the first
-// arrival and of its real-or-null choice (a low-discrepancy pair).
+// Delta tracking's choice at an arrival: real with probability
+// sigma_t / sigma_maj. The first choice's uniform may be given (a
+// low-discrepancy number, in [0, 1)); the others are drawn from rng.
+struct DeltaTrackingChoice {
+  float firstU = -1.f;  // negative: none (left)
+
+  MMRTM_CPU_GPU bool Real(float sigma_t, float sigma_maj, PCG32& rng, TraceCounters& ctr) {
+    const float u = firstU >= 0.f ? firstU : rng.Uniform();
+    firstU = -1.f;
+    if (u * sigma_maj < sigma_t) {
+      ++ctr.realCollisions;
+      return true;
+    }
+    ++ctr.nullCollisions;
+    return false;
+  }
+};
+
+// Delta tracking: the first real collision along ray up to tMax. `first`,
+// when given, holds the uniforms of the first arrival and of its
+// real-or-null choice (a low-discrepancy pair).
 MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
                                                TraceCounters& ctr, const float* first = nullptr) {
   FreePathResult r;
-  bool firstChoice = first != nullptr;
-  SampleTentativeCollisions(
-      s, ray, tMax, 1.f, rng, ctr,
-      [&](float t, const Classification& c, float sigma_maj) {
-        const float u = firstChoice ? first[1] : rng.Uniform();
-        firstChoice = false;
-        if (u * sigma_maj < c.sigma_t) {
-          ++ctr.realCollisions;
-          r.collided = true;
-          r.t = t;
-          r.c = c;
-          return false;
-        }
-        ++ctr.nullCollisions;
-        return true;
-      },
-      [](const RayMajorantSegment&) { return true; }, first ? first[0] : -1.f);
+  TentativeCollisionWalk<false> walk(s, ray, tMax, 1.f);
+  if (!walk.InDomain()) return r;
+  walk.Start(rng, first ? first[0] : -1.f);
+  DeltaTrackingChoice choice{first ? first[1] : -1.f};
+  while (walk.Next(ctr)) {
+    const Classification c = LookupAndCount(s, ray(walk.T()), walk.IndexPoint(), walk.Majorant(), 1.f, ctr);
+    if (choice.Real(c.sigma_t, walk.Majorant(), rng, ctr)) {
+      r.collided = true;
+      r.t = walk.T();
+      r.c = c;
+      return r;
+    }
+    walk.DrawNextArrival(rng);
+  }
   return r;
 }
 
