@@ -77,9 +77,10 @@ options:
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
                         cpu, or cuda (an error without a CUDA device)
-  --simd M              the CPU's: auto (SIMD lanes where this build and CPU have
-                        them; default) or off (the scalar tracker, for comparison;
-                        the same image)
+  --simd M              the CPU's tracker: auto (the faster for the scene; today
+                        the scalar one everywhere; default), on (camera rays in
+                        SIMD lanes where this build and CPU have them) or off
+                        (scalar); the same image to the last bit
   --estimator E         delta (unbiased, default) or raymarch (biased baseline)
   --accelerator A       majorants for delta tracking: none (one global majorant),
                         macrocell (uniform grid), octree (default: the hierarchical
@@ -215,7 +216,7 @@ Options ParseArguments(int argc, char** argv) {
     } else if (a == "--simd") {
       const std::string m = value();
       const auto simd = mmrtm::ParseSimdMode(m);
-      if (!simd) UsageError("--simd expects auto or off, got '" + m + "'");
+      if (!simd) UsageError("--simd expects auto, on or off, got '" + m + "'");
       o.simd = *simd;
     } else if (a == "--max-bounces")
       o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);

@@ -8,7 +8,8 @@ Builds the project in BUILD_DIR with -DMMRTM_PLANTED_DEFECTS=ON (the
 defects compiled in, CPU only, nothing but the checks' targets), runs the
 checks once with no defect (all must pass, or the table means nothing),
 then once per defect with MMRTM_PLANTED_DEFECT=<name>, in CHECKS' order,
-until one fails. Prints the table (defect, the check that caught it, the
+until one fails; that check runs again with the CPU's SIMD lanes
+(MMRTM_CPU_SIMD=on) and must fail there too. Prints the table (defect, the check that caught it, the
 first line of its failure: the score) and writes it as Markdown with
 --table. Exits 1 if a defect is caught by nothing or a check fails without
 one.
@@ -77,10 +78,13 @@ def first_failure(output):
     return lines[-1].strip()[:300] if lines else "(no output)"
 
 
-def run_check(build, headless, check, defect):
+def run_check(build, headless, check, defect, simd="off"):
+    """Runs a check with the CPU's tracker `simd` (MMRTM_CPU_SIMD: off, the
+    scalar one, or on, the SIMD lanes)."""
     name, exe, args, needs_x = check
     env = dict(os.environ)
     env.pop("MMRTM_PLANTED_DEFECT", None)
+    env["MMRTM_CPU_SIMD"] = simd
     if defect:
         env["MMRTM_PLANTED_DEFECT"] = defect
     command = [str(Path(build) / "bin" / exe), *args]
@@ -106,35 +110,41 @@ def main():
 
     ok = True
     for check in CHECKS:
-        passed, output, seconds = run_check(args.build, headless, check, None)
-        print(f"no defect: {check[0]}: {'passes' if passed else 'FAILS'} ({seconds:.1f} s)", flush=True)
-        if not passed:
-            print(output[-3000:])
-            ok = False
+        for simd in ("off", "on"):
+            passed, output, seconds = run_check(args.build, headless, check, None, simd)
+            print(f"no defect: {check[0]} (simd {simd}): {'passes' if passed else 'FAILS'} ({seconds:.1f} s)",
+                  flush=True)
+            if not passed:
+                print(output[-3000:])
+                ok = False
     if not ok:
         print("a check fails without a planted defect: fix that first")
         return 1
 
     rows = []
     for defect in args.defect or DEFECTS:
-        caught = None
+        caught, lanes = None, None
         for check in CHECKS:
             passed, output, seconds = run_check(args.build, headless, check, defect)
             if not passed:
                 caught = (check[0], first_failure(output), seconds)
+                # The same check with the CPU's SIMD lanes must catch it too.
+                lanes = not run_check(args.build, headless, check, defect, "on")[0]
                 break
-        rows.append((defect, caught))
-        print(f"{defect}: " + (f"caught by {caught[0]} ({caught[2]:.1f} s): {caught[1]}" if caught
-                               else "NOT CAUGHT"), flush=True)
+        rows.append((defect, caught, lanes))
+        print(f"{defect}: " + (f"caught by {caught[0]} ({caught[2]:.1f} s; with SIMD lanes: "
+                               f"{'caught' if lanes else 'MISSED'}): {caught[1]}" if caught else "NOT CAUGHT"),
+              flush=True)
 
-    table = ["| planted defect | caught by | its score (the first failure) |", "|---|---|---|"]
-    for defect, caught in rows:
+    table = ["| planted defect | caught by | with SIMD lanes | its score (the first failure) |", "|---|---|---|---|"]
+    for defect, caught, lanes in rows:
         score = caught[1].replace("|", "/") if caught else ""
-        table.append(f"| `{defect}` | {caught[0] if caught else '**nothing**'} | {score} |")
+        table.append(f"| `{defect}` | {caught[0] if caught else '**nothing**'} | "
+                     f"{'caught' if lanes else '**missed**'} | {score} |")
     print("\n".join(table))
     if args.table:
         Path(args.table).write_text("\n".join(table) + "\n")
-    missed = [d for d, c in rows if not c]
+    missed = [d for d, c, lanes in rows if not c or not lanes]
     if missed:
         print(f"not caught: {', '.join(missed)}")
         return 1

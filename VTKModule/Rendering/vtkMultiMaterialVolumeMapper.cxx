@@ -519,11 +519,11 @@ void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
     this->DisplayEdit([&] { this->ToneMapping = mode; });
 }
 
-void vtkMultiMaterialVolumeMapper::SetCpuSimd(vtkTypeBool simd)
+void vtkMultiMaterialVolumeMapper::SetCpuSimd(int mode)
 {
-  simd = simd ? 1 : 0;
-  if (simd != this->CpuSimd)
-    this->DisplayEdit([&] { this->CpuSimd = simd; });
+  mode = std::clamp(mode, static_cast<int>(CPU_SIMD_AUTO), static_cast<int>(CPU_SIMD_OFF));
+  if (mode != this->CpuSimd)
+    this->DisplayEdit([&] { this->CpuSimd = mode; });
 }
 
 void vtkMultiMaterialVolumeMapper::SetLookToVTK()
@@ -1277,7 +1277,9 @@ void vtkMultiMaterialVolumeMapper::UpdateRenderer()
                                                       : mmrtm::Backend::Auto;
   in.Renderer = mmrtm::MakeRenderer(
     backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); },
-    this->CpuSimd ? mmrtm::SimdMode::Auto : mmrtm::SimdMode::Off);
+    this->CpuSimd == CPU_SIMD_ON      ? mmrtm::SimdMode::On
+      : this->CpuSimd == CPU_SIMD_OFF ? mmrtm::SimdMode::Off
+                                      : mmrtm::SimdMode::Auto);
   in.RendererBackend = this->Backend;
   in.RendererThreads = this->NumberOfThreads;
   in.RendererCpuSimd = this->CpuSimd;

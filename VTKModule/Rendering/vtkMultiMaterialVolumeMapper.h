@@ -136,16 +136,24 @@ public:
   void SetBackendToCUDA() { this->SetBackend(CUDA); }
   ///@}
 
+  enum CpuSimdModes
+  {
+    CPU_SIMD_AUTO = 0,
+    CPU_SIMD_ON = 1,
+    CPU_SIMD_OFF = 2
+  };
   ///@{
   /**
-   * On the CPU, trace in SIMD lanes where this build and CPU have them (on,
-   * the default), or with the scalar tracker (off, for comparison: the
-   * same image to the last bit, so the accumulation goes on). mmrtm-render's
-   * --simd auto|off.
+   * The CPU's tracker: AUTO (default) the faster for the scene (today the
+   * scalar one everywhere), ON camera rays in SIMD lanes where this build
+   * and CPU have them, OFF the scalar one. The same image to the last bit
+   * either way, so a change keeps the accumulation. mmrtm-render's --simd.
    */
-  virtual void SetCpuSimd(vtkTypeBool simd);
-  vtkGetMacro(CpuSimd, vtkTypeBool);
-  vtkBooleanMacro(CpuSimd, vtkTypeBool);
+  virtual void SetCpuSimd(int mode);
+  vtkGetMacro(CpuSimd, int);
+  void SetCpuSimdToAuto() { this->SetCpuSimd(CPU_SIMD_AUTO); }
+  void SetCpuSimdToOn() { this->SetCpuSimd(CPU_SIMD_ON); }
+  void SetCpuSimdToOff() { this->SetCpuSimd(CPU_SIMD_OFF); }
   ///@}
 
   enum Accelerators
@@ -550,7 +558,7 @@ protected:
   int Seed = 0;
   int NumberOfThreads = 0;
   int Backend = AUTO;
-  vtkTypeBool CpuSimd = 1;
+  int CpuSimd = CPU_SIMD_AUTO;
   double Exposure = 1.0;
   int ToneMapping = AUTOMATIC_TONE_MAPPING;
   vtkTypeBool UnshadedScattering = 0;

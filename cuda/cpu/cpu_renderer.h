@@ -17,17 +17,21 @@
 
 namespace mmrtm {
 
-// --simd off|auto. Auto: the SIMD backend where it runs (a build with
-// Highway, delta tracking, no intensity projection): a tile's camera rays
-// tracked together with their lookups in SIMD lanes
-// (wavefront_camera_paths.h). Off: the scalar backend, for comparison.
-// Both give the same image to the last bit.
-enum class SimdMode { Off, Auto };
+// --simd auto|on|off. On: the SIMD backend where it runs (a build with
+// Highway, delta tracking over a majorant grid, no intensity projection:
+// WavefrontCameraPaths::Runs): a tile's camera rays delta-tracked in SIMD
+// lanes (wavefront_camera_paths.h). Off: the scalar backend. Both give the
+// same image to the last bit. Auto: the faster of the two for the scene,
+// which is the scalar backend on every scene measured so far (the lanes
+// took 1.02-1.08 times its time: Documentation/performance.md, "SIMD
+// lanes"), so that no user pays for lanes that do not pay yet.
+enum class SimdMode { Off, Auto, On };
 std::optional<SimdMode> ParseSimdMode(const std::string& name);
 
 class CpuRenderer {
  public:
-  // threads <= 0: one per hardware thread.
+  // threads <= 0: one per hardware thread. `simd` Auto takes the
+  // environment's MMRTM_CPU_SIMD (on, off) where it is set.
   explicit CpuRenderer(int threads = 0, SimdMode simd = SimdMode::Auto);
   int Threads() const { return threads_; }
   SimdMode Simd() const { return simd_; }

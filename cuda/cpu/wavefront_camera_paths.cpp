@@ -1,10 +1,18 @@
 #include "wavefront_camera_paths.h"
 
 #ifdef MMRTM_HAVE_SIMD
+#include "grid_walk_lanes.h"
 #include "plain_extinction.h"
 #endif
 
 namespace mmrtm {
+
+#ifndef MMRTM_HAVE_SIMD
+struct GridWalkLanes {};
+#endif
+
+WavefrontCameraPaths::WavefrontCameraPaths() : walks_(std::make_unique<GridWalkLanes>()) {}
+WavefrontCameraPaths::~WavefrontCameraPaths() = default;
 
 bool SimdLookupsBuilt() {
 #ifdef MMRTM_HAVE_SIMD
@@ -22,7 +30,55 @@ const char* SimdLookupTarget() {
 #endif
 }
 
-void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& paths, bool simd, LaneCounters* lanes) {
+namespace {
+
+#ifdef MMRTM_HAVE_SIMD
+// DeltaTrack's choice at a camera path's arrival, with the path's random
+// numbers and counters.
+class CameraChoices : public ArrivalChoices {
+ public:
+  CameraChoices(const SceneView& s, std::vector<CameraPath>& paths) : s_(s), paths_(paths) {}
+
+  bool Real(uint32_t i, float t, Vec3 p, float sigma_maj, const float* sigma_t, float* tau) override {
+    CameraPath& path = paths_[i];
+    Classification c;
+    if (!sigma_t) c = s_.classifier.Classify(path.sample.ray(t), p);
+    const float extinction = sigma_t ? *sigma_t : c.sigma_t;
+    CountLookup(extinction, sigma_maj, 1.f, path.ctr);
+    if (path.choice.Real(extinction, sigma_maj, path.sample.rng, path.ctr)) {
+      path.freePath.collided = true;
+      path.freePath.t = t;
+      // The lanes gave a plain scene's extinction only: the collision's
+      // whole classification is one more scalar lookup (one a path).
+      path.freePath.c = sigma_t ? s_.classifier.Classify(path.sample.ray(t), p) : c;
+      return true;
+    }
+    *tau = TentativeCollisionWalk<false>::OpticalDepthToArrival(path.sample.rng.Uniform());
+    return false;
+  }
+
+ private:
+  const SceneView& s_;
+  std::vector<CameraPath>& paths_;
+};
+#endif
+
+}  // namespace
+
+bool WavefrontCameraPaths::Runs(const SceneView& s) {
+#ifdef MMRTM_HAVE_SIMD
+  return s.settings.estimator == Estimator::DeltaTracking && s.majorants.kind != MajorantKind::Global &&
+         GridWalkLanesFit(s.majorants.grid) && PlainLookupsFit(s.classifier);
+#else
+  (void)s;
+  return false;
+#endif
+}
+
+void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& paths, LaneCounters* lanes) {
+#ifdef MMRTM_HAVE_SIMD
+  MMRTM_DCHECK(Runs(s));
+  walks_->Resize(paths.size());
   walking_.clear();
   for (uint32_t i = 0; i < (uint32_t)paths.size(); ++i) {
     CameraPath& path = paths[i];
@@ -32,75 +88,26 @@ void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& pa
     path.sample.FreePathPair(&u0, &u1);
     path.walk.Start(path.sample.rng, u0);
     path.choice = DeltaTrackingChoice{u1};
+    walks_->Set(i, path.walk.Iterator().GridWalk()->State(), path.walk.Tau());
     walking_.push_back(i);
   }
-  while (!walking_.empty()) {
-    // Each walking path to its next arrival; a path whose ray ends has no
-    // collision.
-    arrived_.clear();
-    x_.clear();
-    y_.clear();
-    z_.clear();
-    for (uint32_t i : walking_) {
-      CameraPath& path = paths[i];
-      if (!path.walk.Next(path.ctr)) continue;
-      const Vec3 p = path.walk.IndexPoint();
-      arrived_.push_back(i);
-      x_.push_back(p.x);
-      y_.push_back(p.y);
-      z_.push_back(p.z);
-    }
-    Lookup(s, paths, simd, lanes);
-    // The choices; the paths that go on walk the next round.
-    walking_.clear();
-    for (size_t k = 0; k < arrived_.size(); ++k) {
-      CameraPath& path = paths[arrived_[k]];
-      const float sigma_maj = path.walk.Majorant();
-      CountLookup(sigma_t_[k], sigma_maj, 1.f, path.ctr);
-      if (path.choice.Real(sigma_t_[k], sigma_maj, path.sample.rng, path.ctr)) {
-        const float t = path.walk.T();
-        path.freePath.collided = true;
-        path.freePath.t = t;
-        // A plain scene's lanes gave the extinction only: the collision's
-        // whole classification, one more scalar lookup (about one a path).
-        path.freePath.c =
-            classified_.empty() ? s.classifier.Classify(path.sample.ray(t), path.walk.IndexPoint()) : classified_[k];
-        continue;
-      }
-      path.walk.DrawNextArrival(path.sample.rng);
-      walking_.push_back(arrived_[k]);
-    }
-  }
-}
-
-void WavefrontCameraPaths::Lookup(const SceneView& s, const std::vector<CameraPath>& paths, bool simd,
-                                  LaneCounters* lanes) {
-  const size_t n = arrived_.size();
-  sigma_t_.resize(n);
-  classified_.clear();
-#ifdef MMRTM_HAVE_SIMD
-  if (simd && s.classifier.plain) {
-    PlainExtinctionSimd(s.classifier, x_.data(), y_.data(), z_.data(), n, sigma_t_.data());
-    if (lanes) {
-      const size_t width = PlainExtinctionLaneCount();
-      ++lanes->calls;
-      lanes->items += n;
-      lanes->lanes += (n + width - 1) / width * width;
-    }
-    return;
-  }
+  const size_t n = walking_.size();
+  collided_.resize(n + 1);
+  t_.resize(n + 1);
+  x_.resize(n + 1);
+  y_.resize(n + 1);
+  z_.resize(n + 1);
+  CameraChoices choices(s, paths);
+  const GridTraversal traversal =
+      s.majorants.kind == MajorantKind::Macrocell ? GridTraversal::Macrocell : GridTraversal::Octree;
+  DeltaTrackWalks(s.classifier, s.majorants.grid, traversal, *walks_, walking_.data(), n, choices, collided_.data(),
+                  t_.data(), x_.data(), y_.data(), z_.data(), lanes);
+  for (uint32_t i : walking_) paths[i].ctr.majorantSegments += (uint64_t)walks_->segments[i];
 #else
-  (void)simd;
+  (void)s;
+  (void)paths;
   (void)lanes;
 #endif
-  // One point at a time, as the scalar tracker looks up (the world point
-  // serves cropping).
-  classified_.resize(n);
-  for (size_t k = 0; k < n; ++k) {
-    const CameraPath& path = paths[arrived_[k]];
-    classified_[k] = s.classifier.Classify(path.sample.ray(path.walk.T()), Vec3{x_[k], y_[k], z_[k]});
-    sigma_t_[k] = classified_[k].sigma_t;
-  }
 }
 
 }  // namespace mmrtm

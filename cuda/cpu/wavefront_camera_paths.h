@@ -14,23 +14,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "mmrtm/integrator.h"
 
 namespace mmrtm {
-
-// How full a stage kept its SIMD lanes: `items` points over `lanes` lanes
-// run (a call over n points runs n rounded up to the vector's width).
-struct LaneCounters {
-  uint64_t calls = 0, items = 0, lanes = 0;
-  LaneCounters& operator+=(const LaneCounters& o) {
-    calls += o.calls;
-    items += o.items;
-    lanes += o.lanes;
-    return *this;
-  }
-};
 
 // A pixel sample on its camera ray, tracked to its free path.
 struct CameraPath {
@@ -44,25 +33,32 @@ struct CameraPath {
   TraceCounters ctr;        // the work of the camera ray's tracking
 };
 
-// Whether this build has the SIMD lookups (MMRTM_ENABLE_SIMD), and the
+// Whether this build has the SIMD lanes (MMRTM_ENABLE_SIMD), and the
 // instruction set they run on here ("AVX3", "AVX2", ...; "" without them).
 bool SimdLookupsBuilt();
 const char* SimdLookupTarget();
 
+struct GridWalkLanes;  // cuda/simd/grid_walk_lanes.h
+
 class WavefrontCameraPaths {
  public:
+  WavefrontCameraPaths();
+  ~WavefrontCameraPaths();
+
+  // Whether the lanes can track `s`'s camera rays: a build with them, delta
+  // tracking over a majorant grid (not the one global majorant), indices
+  // and a plain scene's voxel offsets within 32 bits.
+  static bool Runs(const SceneView& s);
+
   // Sets every path's freePath (and ctr), as DeltaTrack would with its
   // random numbers; the paths' rngs are left where DeltaTrack leaves them.
-  // `simd` false: the lookups one point at a time (the same bits).
-  void Track(const SceneView& s, std::vector<CameraPath>& paths, bool simd, LaneCounters* lanes);
+  void Track(const SceneView& s, std::vector<CameraPath>& paths, LaneCounters* lanes);
 
  private:
-  // sigma_t_ (and classified_ where the lanes do not run) of the arrivals.
-  void Lookup(const SceneView& s, const std::vector<CameraPath>& paths, bool simd, LaneCounters* lanes);
-
-  std::vector<uint32_t> walking_, arrived_;  // path indices
-  std::vector<float> x_, y_, z_, sigma_t_;   // the arrivals' index points and extinctions
-  std::vector<Classification> classified_;   // a scene not plain: the arrivals' classifications
+  std::unique_ptr<GridWalkLanes> walks_;  // the paths' majorant walks, in lanes
+  std::vector<uint32_t> walking_;         // the paths in the domain
+  std::vector<int32_t> collided_;         // each walking path: collided (1) or not (0)
+  std::vector<float> t_, x_, y_, z_;      // and where
 };
 
 }  // namespace mmrtm

@@ -26,7 +26,7 @@ void WavefrontTile::Render(const SceneView& s, const Film& film, const FilmView&
 }
 
 void WavefrontTile::Finish(const SceneView& s, const FilmView& view, TraceCounters& ctr, LaneCounters* lanes) {
-  tracker_.Track(s, paths_, true, lanes);
+  tracker_.Track(s, paths_, lanes);
   for (size_t i = 0; i < paths_.size(); ++i) {
     CameraPath& path = paths_[i];
     const Origin& o = origins_[i];

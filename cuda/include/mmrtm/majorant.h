@@ -37,6 +37,9 @@ class MajorantIterator {
     return MajorantIterator(grid, traversal, indexRay, tMin, tMax, scale);
   }
 
+  // The grid walk, or null (one global segment).
+  MMRTM_CPU_GPU const GridMajorantIterator* GridWalk() const { return isGrid_ ? &grid_ : nullptr; }
+
   MMRTM_INLINE MMRTM_CPU_GPU bool Next(RayMajorantSegment* seg) {  // forced: see GridMajorantIterator::Next
     if (isGrid_) return grid_.Next(&seg->tMin, &seg->tMax, &seg->sigma_maj, &seg->sigma_min);
     if (!pending_) return false;

@@ -75,6 +75,16 @@ MMRTM_CPU_GPU inline uint8_t EncodeMinorant(float majorant, float minorant) {
   return (uint8_t)q;
 }
 
+// The state of a walk over the grid (GridMajorantIterator's), for the SIMD
+// walk that continues many of them in lanes (cuda/simd/grid_walk_lanes.h).
+struct GridWalkState {
+  Vec3 o, d;  // the ray in index space
+  float invD[3], tClip[3], tFace[3];
+  float t, tEnd, scale;
+  int level, cell[3], step[3];
+  int64_t node;
+};
+
 // Walks the grid along a ray given in voxel index space (its parameter t is
 // the world distance), handing out majorant segments.
 class GridMajorantIterator {
@@ -104,6 +114,26 @@ class GridMajorantIterator {
     }
     EnterLevel();
   }
+
+  MMRTM_CPU_GPU GridWalkState State() const {
+    GridWalkState s;
+    s.o = o_;
+    s.d = d_;
+    for (int a = 0; a < 3; ++a) {
+      s.invD[a] = invD_[a];
+      s.tClip[a] = tClip_[a];
+      s.tFace[a] = tFace_[a];
+      s.cell[a] = cell_[a];
+      s.step[a] = step_[a];
+    }
+    s.t = t_;
+    s.tEnd = tEnd_;
+    s.scale = scale_;
+    s.level = level_;
+    s.node = node_;
+    return s;
+  }
+  MMRTM_CPU_GPU GridTraversal Traversal() const { return traversal_; }
 
   // The next segment with a non-zero majorant, and a lower bound of the
   // extinction over it (0 without minorants); false at the end of the ray.

@@ -80,9 +80,13 @@ class TentativeCollisionWalk {
   // Draws the optical depth to the first arrival: `uFirst` when in [0, 1)
   // (a low-discrepancy number), otherwise from rng. Only for a walk in
   // the domain, before the first Next.
-  MMRTM_CPU_GPU void Start(PCG32& rng, float uFirst) { tau_ = -logf(1.f - (uFirst >= 0.f ? uFirst : rng.Uniform())); }
+  MMRTM_CPU_GPU void Start(PCG32& rng, float uFirst) {
+    tau_ = OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
+  }
   // After an arrival that did not end the walk: the optical depth to the next.
-  MMRTM_CPU_GPU void DrawNextArrival(PCG32& rng) { tau_ = -logf(1.f - rng.Uniform()); }
+  MMRTM_CPU_GPU void DrawNextArrival(PCG32& rng) { tau_ = OpticalDepthToArrival(rng.Uniform()); }
+  // The optical depth to an arrival, Exp(1), from a uniform u.
+  MMRTM_CPU_GPU static float OpticalDepthToArrival(float u) { return -logf(1.f - u); }
 
   // Advances to the next arrival, false at the end of the ray.
   // segment(seg) is called first for every segment (Residual only); false
@@ -124,6 +128,13 @@ class TentativeCollisionWalk {
   // The segment of the arrival; with Residual, its sigma_maj is the
   // residual rate.
   MMRTM_CPU_GPU const RayMajorantSegment& Segment() const { return seg_; }
+  // For the SIMD walk that continues this one (cuda/simd/grid_walk_lanes.h):
+  // the majorant walk, and the optical depth to the next arrival.
+  MMRTM_CPU_GPU const MajorantIterator& Iterator() const { return it_; }
+  MMRTM_CPU_GPU float Tau() const { return tau_; }
+  MMRTM_CPU_GPU bool InSegment() const { return inSegment_; }
+  MMRTM_CPU_GPU const Ray& IndexRay() const { return indexRay_; }
+
   // The bound the (scaled) extinction at the arrival must keep.
   MMRTM_CPU_GPU float Majorant() const { return Residual ? seg_.sigma_maj + seg_.sigma_min : seg_.sigma_maj; }
 

@@ -1,0 +1,69 @@
+// Delta tracking of many rays in SIMD lanes, a lane a ray: the walk over
+// the majorant grid to each tentative collision (GridMajorantIterator::Next:
+// the octree's climb / descend / 3D-DDA step, or the macrocell grid's step;
+// TentativeCollisionWalk<false>::Next: the optical depth used up segment by
+// segment), the extinction there (a plain scene's, in lanes), and the
+// caller's real-or-null choice, with masks for the lanes that arrive,
+// collide or end early. Every operation is the scalar walk's, in its order, so a walk
+// gives the same segments and arrivals to the last bit
+// (Testing/Cxx/TestSimdBackend: any drift between the two fails there on
+// every scene). One step of the climb to the highest empty ancestor is
+// taken a round, which arrives at the same node.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "mmrtm/classifier.h"
+#include "mmrtm/counters.h"
+#include "mmrtm/majorant_grid_view.h"
+
+namespace mmrtm {
+
+// The walks' state in structure-of-arrays form: slot i is walk i; the
+// slot after the last is scratch, where padded lanes read and write.
+struct GridWalkLanes {
+  std::vector<float> o[3], d[3], invD[3], tClip[3], tFace[3];
+  std::vector<float> itT, tEnd;                    // the grid walk's distance and end
+  std::vector<float> walkT, tau, segTMax, segMaj;  // TentativeCollisionWalk's
+  std::vector<int32_t> cell[3], step[3], level, node;
+  std::vector<int32_t> inSegment, emptyClimb;  // 0 or 1 (-1 in lanes)
+  std::vector<int32_t> segments;               // majorant segments handed out, a count per walk
+
+  // Room for n walks (and the scratch slot, an ended walk).
+  void Resize(size_t n);
+  // Walk i from a scalar walk's state (`tau`: its optical depth to the first
+  // arrival); no segment yet.
+  void Set(size_t i, const GridWalkState& s, float tau);
+};
+
+// Whether the lanes can walk `grid`: its node indices fit 32 bits.
+bool GridWalkLanesFit(const MajorantGridView& grid);
+
+// The caller's side of delta tracking: the choice at each arrival, made
+// with the walk's own random numbers, one arrival at a time.
+class ArrivalChoices {
+ public:
+  virtual ~ArrivalChoices() = default;
+  // Walk `walk` arrived at distance t, index point p, in a segment of
+  // majorant sigma_maj; `sigma_t`: the extinction there as the lanes looked
+  // it up, or null (a scene not plain: the caller classifies). True for a
+  // real collision (the walk is over); otherwise sets *tau, the optical
+  // depth to the walk's next arrival.
+  virtual bool Real(uint32_t walk, float t, Vec3 p, float sigma_maj, const float* sigma_t, float* tau) = 0;
+};
+
+// Whether a plain scene's lookups fit the lanes' 32-bit gathers (always
+// true for a scene that is not plain: the caller looks up).
+bool PlainLookupsFit(const Classifier& classifier);
+
+// Delta-tracks walks ids[0..count) to their first real collision or their
+// end (DeltaTrack's walk and choices): collided[k] is 1 and (t, x, y,
+// z)[k] the collision's distance and index point, or collided[k] is 0.
+// The output arrays hold count + 1 values (the last is scratch).
+void DeltaTrackWalks(const Classifier& classifier, const MajorantGridView& grid, GridTraversal traversal,
+                     GridWalkLanes& walks, const uint32_t* ids, size_t count, ArrivalChoices& choices,
+                     int32_t* collided, float* t, float* x, float* y, float* z, LaneCounters* counters);
+
+}  // namespace mmrtm
