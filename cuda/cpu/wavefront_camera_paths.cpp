@@ -53,7 +53,7 @@ class CameraChoices : public ArrivalChoices {
       path.freePath.c = sigma_t ? s_.classifier.Classify(path.sample.ray(t), p) : c;
       return true;
     }
-    *tau = TentativeCollisionWalk<false>::OpticalDepthToArrival(path.sample.rng.Uniform());
+    *tau = TentativeCollisionStart::OpticalDepthToArrival(path.sample.rng.Uniform());
     return false;
   }
 
@@ -83,12 +83,12 @@ void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& pa
   for (uint32_t i = 0; i < (uint32_t)paths.size(); ++i) {
     CameraPath& path = paths[i];
     path.freePath = FreePathResult();
-    if (!path.walk.InDomain()) continue;
+    if (!path.walk.inDomain) continue;
     float u0, u1;
     path.sample.FreePathPair(&u0, &u1);
-    path.walk.Start(path.sample.rng, u0);
+    path.walk.DrawFirstArrival(path.sample.rng, u0);
     path.choice = DeltaTrackingChoice{u1};
-    walks_->Set(i, path.walk.Iterator().GridWalk()->State(), path.walk.Tau());
+    walks_->Set(i, path.walk.it.GridWalk()->State(), path.walk.tau);
     walking_.push_back(i);
   }
   const size_t n = walking_.size();

@@ -27,7 +27,7 @@ struct CameraPath {
       : sample(s, x, y, sampleIndex), walk(s, sample.ray, sample.tMax, 1.f) {}
 
   CameraSample sample;
-  TentativeCollisionWalk<false> walk;
+  TentativeCollisionStart walk;
   DeltaTrackingChoice choice;
   FreePathResult freePath;  // the result
   TraceCounters ctr;        // the work of the camera ray's tracking

@@ -2,7 +2,7 @@
 // with -ffp-contract=off (cuda/CMakeLists.txt), so that every operation
 // rounds as the scalar walk's does. The scalar walk, mirrored here operation
 // by operation, is GridMajorantIterator (mmrtm/majorant_grid_view.h) and
-// TentativeCollisionWalk<false>::Next (mmrtm/tracking.h).
+// the loop of SampleTentativeCollisions (mmrtm/tracking.h) for delta tracking.
 #include "grid_walk_lanes.h"
 
 #include <cstring>
@@ -224,7 +224,7 @@ HWY_INLINE MF Act(const MajorantGridView& grid, const LevelTables& tables, bool 
   const DI di;
   const VF zeroF = hn::Zero(df);
   const VI zeroI = hn::Zero(di), oneI = hn::Set(di, 1);
-  // In a segment (TentativeCollisionWalk::Next).
+  // In a segment (SampleTentativeCollisions' inner loop).
   const MF inSegment = hn::And(live, w.inSegment);
   const VF tauLeft = (w.segTMax - w.walkT) * w.segMaj;
   const MF usedUp = hn::And(inSegment, w.tau >= tauLeft);
@@ -272,7 +272,7 @@ HWY_INLINE MF Act(const MajorantGridView& grid, const LevelTables& tables, bool 
   const VF tExit = ExitDistance(w, &axis);
   const VF segTMin = w.itT, segMaj = maj * scale;
   const MF moved = Step(tables, stepping, axis, tExit, w);
-  // A segment handed out, which the TentativeCollisionWalk takes.
+  // A segment handed out, taken by the loop over segments.
   w.segments = SelI(emit, w.segments + oneI, w.segments);
   w.segMaj = Sel(emit, segMaj, w.segMaj);
   w.segTMax = Sel(emit, Sel(moved, tExit, w.tEnd), w.segTMax);

@@ -1,14 +1,14 @@
 // Delta tracking of many rays in SIMD lanes, a lane a ray: the walk over
 // the majorant grid to each tentative collision (GridMajorantIterator::Next:
 // the octree's climb / descend / 3D-DDA step, or the macrocell grid's step;
-// TentativeCollisionWalk<false>::Next: the optical depth used up segment by
+// SampleTentativeCollisions: the optical depth used up segment by
 // segment), the extinction there (a plain scene's, in lanes), and the
 // caller's real-or-null choice, with masks for the lanes that arrive,
 // collide or end early. Every operation is the scalar walk's, in its order, so a walk
 // gives the same segments and arrivals to the last bit
 // (Testing/Cxx/TestSimdBackend: any drift between the two fails there on
-// every scene). One step of the climb to the highest empty ancestor is
-// taken a round, which arrives at the same node.
+// every scene). The climb to the highest empty ancestor takes one level an
+// action, and arrives at the same node.
 #pragma once
 
 #include <cstddef>
@@ -26,7 +26,7 @@ namespace mmrtm {
 struct GridWalkLanes {
   std::vector<float> o[3], d[3], invD[3], tClip[3], tFace[3];
   std::vector<float> itT, tEnd;                    // the grid walk's distance and end
-  std::vector<float> walkT, tau, segTMax, segMaj;  // TentativeCollisionWalk's
+  std::vector<float> walkT, tau, segTMax, segMaj;  // SampleTentativeCollisions' (the arrival's t, ...)
   std::vector<int32_t> cell[3], step[3], level, node;
   std::vector<int32_t> inSegment, emptyClimb;  // 0 or 1 (-1 in lanes)
   std::vector<int32_t> segments;               // majorant segments handed out, a count per walk

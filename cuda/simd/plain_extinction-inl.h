@@ -14,6 +14,7 @@
 #include <hwy/highway.h>
 
 #include "mmrtm/classifier.h"
+#include "mmrtm/planted_defect.h"
 #include "simd/highway_lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -139,7 +140,9 @@ struct PlainScene {
 
   // The extinction at index points (px, py, pz): Classifier::Classify's.
   inline Float Extinction(Float px, Float py, Float pz) const {
-    return classifier.PlainExtinction<Lanes>({DensityTFLanes(tf, SampleIndexLanes(volume, voxels, px, py, pz))}).raw;
+    const Float sigma_t =
+        classifier.PlainExtinction<Lanes>({DensityTFLanes(tf, SampleIndexLanes(volume, voxels, px, py, pz))}).raw;
+    return Planted(Defect::SimdExtinction) ? sigma_t * hn::Set(DF(), 0.98f) : sigma_t;
   }
 };
 

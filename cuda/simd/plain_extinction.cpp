@@ -4,8 +4,6 @@
 // does and the results are the same bits.
 #include "plain_extinction.h"
 
-#include "mmrtm/planted_defect.h"
-
 #include <cstring>
 
 #undef HWY_TARGET_INCLUDE
@@ -80,8 +78,6 @@ void PlainExtinctionSimd(const Classifier& classifier, const float* x, const flo
   // bytes of the buffer.
   if (bytes < 4 || bytes >= ((int64_t)1 << 31)) return PlainExtinctionScalar(classifier, x, y, z, count, sigma_t);
   HWY_DYNAMIC_DISPATCH(PlainExtinctionLanes)(classifier, x, y, z, count, sigma_t);
-  if (Planted(Defect::SimdExtinction))
-    for (size_t i = 0; i < count; ++i) sigma_t[i] *= 0.98f;
 }
 
 void PlainExtinctionScalar(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,

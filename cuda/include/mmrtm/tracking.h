@@ -47,14 +47,38 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, V
   return c;
 }
 
-// A walk over the tentative collisions of a ray up to tMax: the arrivals of
-// a Poisson process whose rate is each majorant segment's sigma_maj
-// (`scale` multiplies the extinction and the majorants). Its state is kept
-// between arrivals, so that a caller can stop at each to look the
-// extinction up: SampleTentativeCollisions looks up at once, the CPU's SIMD
-// backend gathers many walks' arrivals into one lookup in lanes
-// (cpu/wavefront_camera_paths.h). Both draw the same random numbers in the
-// same order per path.
+// The start of a walk over a ray's tentative collisions up to tMax (the
+// arrivals of a Poisson process whose rate is each majorant segment's
+// sigma_maj; `scale` multiplies the extinction and the majorants): the
+// ray's interval in the domain, the majorant walk built in place (a copy
+// of the grid walk's state costs about 55 instructions: mmrtm/majorant.h)
+// and the optical depth to the first arrival. SampleTentativeCollisions
+// walks on from it; the CPU's SIMD lanes take it over for many rays
+// (cuda/simd/grid_walk_lanes.h), each drawing its own random numbers in
+// the same order.
+struct TentativeCollisionStart {
+  Ray indexRay;
+  float t0, t1;
+  bool inDomain;
+  MajorantIterator it;
+  float tau = 0.f;  // optical depth to the next arrival
+
+  MMRTM_CPU_GPU TentativeCollisionStart(const SceneView& s, const Ray& ray, float tMax, float scale)
+      : inDomain(s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)),
+        it(inDomain ? s.majorants.Begin(indexRay, t0, t1, scale) : MajorantIterator()) {}
+
+  // Draws the optical depth to the first arrival (a ray in the domain):
+  // `uFirst` when in [0, 1) (a low-discrepancy number), otherwise from rng.
+  MMRTM_CPU_GPU void DrawFirstArrival(PCG32& rng, float uFirst) {
+    tau = OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
+  }
+  // The optical depth to an arrival, Exp(1), from a uniform u.
+  MMRTM_CPU_GPU static float OpticalDepthToArrival(float u) { return -logf(1.f - u); }
+};
+
+// Walks the tentative collisions of a ray up to tMax and calls visit(t,
+// classification, sigma_maj) at each until visit returns false or the ray
+// ends.
 //
 // The optical depth to the next arrival is drawn once, Exp(1), and what a
 // segment does not use up carries into the next (pbrt-v4's SampleT_maj
@@ -62,114 +86,54 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, V
 // also allows). The same distribution; but a segment without a collision
 // costs a multiply and a compare instead of a random number and a logf, and
 // an octree walk hands out about two segments per lookup.
+// `uFirst` as in TentativeCollisionStart::DrawFirstArrival.
 //
+// segment(seg) is called first for every segment; false ends the walk.
 // With `Residual` the arrivals' rate is sigma_maj - sigma_min instead (the
 // residual of residual ratio tracking, which takes the control part,
-// exp(-sigma_min * length), in Next's `segment`).
-template <bool Residual>
-class TentativeCollisionWalk {
- public:
-  // The walk of `ray` over the domain (empty where the ray misses it).
-  // Built in place: a copy of the grid walk's state costs about 55
-  // instructions (mmrtm/majorant.h).
-  MMRTM_CPU_GPU TentativeCollisionWalk(const SceneView& s, const Ray& ray, float tMax, float scale)
-      : inDomain_(s.DomainInterval(ray, tMax, &indexRay_, &t0_, &t1_)),
-        it_(inDomain_ ? s.majorants.Begin(indexRay_, t0_, t1_, scale) : MajorantIterator()) {}
-
-  MMRTM_CPU_GPU bool InDomain() const { return inDomain_; }
-  // Draws the optical depth to the first arrival: `uFirst` when in [0, 1)
-  // (a low-discrepancy number), otherwise from rng. Only for a walk in
-  // the domain, before the first Next.
-  MMRTM_CPU_GPU void Start(PCG32& rng, float uFirst) {
-    tau_ = OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
-  }
-  // After an arrival that did not end the walk: the optical depth to the next.
-  MMRTM_CPU_GPU void DrawNextArrival(PCG32& rng) { tau_ = OpticalDepthToArrival(rng.Uniform()); }
-  // The optical depth to an arrival, Exp(1), from a uniform u.
-  MMRTM_CPU_GPU static float OpticalDepthToArrival(float u) { return -logf(1.f - u); }
-
-  // Advances to the next arrival, false at the end of the ray.
-  // segment(seg) is called first for every segment (Residual only); false
-  // ends the walk.
-  template <typename OnSegment>
-  MMRTM_INLINE MMRTM_CPU_GPU bool Next(TraceCounters& ctr, OnSegment segment) {
-    for (;;) {
-      if (!inSegment_) {
-        if (!it_.Next(&seg_)) return false;
-        ++ctr.majorantSegments;
-        if constexpr (Residual) {
-          if (Planted(Defect::ShadowLastSegment) && seg_.tMax >= t1_) return false;
-          if (!segment(seg_)) return false;
-          seg_.sigma_maj -= seg_.sigma_min;
-        }
-        if (seg_.sigma_maj <= 0.f) continue;
-        t_ = seg_.tMin;
-        inSegment_ = true;
-      }
-      const float tauLeft = (seg_.tMax - t_) * seg_.sigma_maj;  // in this segment
-      if (tau_ >= tauLeft) {
-        tau_ -= tauLeft;
-        inSegment_ = false;
-        continue;
-      }
-      t_ += tau_ / seg_.sigma_maj;  // below tMax but for rounding, which lands on this node's face
-      return true;
-    }
-  }
-  MMRTM_INLINE MMRTM_CPU_GPU bool Next(TraceCounters& ctr) {
-    return Next(ctr, [](const RayMajorantSegment&) { return true; });
-  }
-
-  // The arrival's distance along the ray.
-  MMRTM_CPU_GPU float T() const { return t_; }
-  // The arrival also in proxy 0's index space: the proxies on proxy 0's
-  // grid are sampled there (Classifier::onProxy0Grid).
-  MMRTM_CPU_GPU Vec3 IndexPoint() const { return indexRay_(t_); }
-  // The segment of the arrival; with Residual, its sigma_maj is the
-  // residual rate.
-  MMRTM_CPU_GPU const RayMajorantSegment& Segment() const { return seg_; }
-  // For the SIMD walk that continues this one (cuda/simd/grid_walk_lanes.h):
-  // the majorant walk, and the optical depth to the next arrival.
-  MMRTM_CPU_GPU const MajorantIterator& Iterator() const { return it_; }
-  MMRTM_CPU_GPU float Tau() const { return tau_; }
-  MMRTM_CPU_GPU bool InSegment() const { return inSegment_; }
-  MMRTM_CPU_GPU const Ray& IndexRay() const { return indexRay_; }
-
-  // The bound the (scaled) extinction at the arrival must keep.
-  MMRTM_CPU_GPU float Majorant() const { return Residual ? seg_.sigma_maj + seg_.sigma_min : seg_.sigma_maj; }
-
- private:
-  Ray indexRay_;
-  float t0_, t1_;
-  bool inDomain_;
-  MajorantIterator it_;
-  RayMajorantSegment seg_;
-  float t_ = 0.f;
-  float tau_ = 0.f;  // optical depth to the next arrival
-  bool inSegment_ = false;
-};
-
-// Walks the tentative collisions of a ray up to tMax (TentativeCollisionWalk)
-// and calls visit(t, classification, sigma_maj) at each until visit returns
-// false or the ray ends. `uFirst` as in TentativeCollisionWalk::Start.
-// With `Residual`, segment(seg) is called first for every segment, and
-// visit gets (classification, residual segment), whose sigma_maj is the
-// residual rate.
+// exp(-sigma_min * length), in segment), and visit gets (classification,
+// residual segment), whose sigma_maj is that rate.
+// The SIMD lanes' walk (cuda/simd/grid_walk_lanes.cpp) mirrors this loop
+// for delta tracking; Testing/Cxx/TestSimdBackend holds the two to the
+// same bits.
 template <bool Residual = false, typename Visit, typename Segment>
 MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
                                                     PCG32& rng, TraceCounters& ctr, Visit visit, Segment segment,
                                                     float uFirst = -1.f) {
-  TentativeCollisionWalk<Residual> walk(s, ray, tMax, scale);
-  if (!walk.InDomain()) return;
-  walk.Start(rng, uFirst);
-  while (walk.Next(ctr, segment)) {
-    const Classification c = LookupAndCount(s, ray(walk.T()), walk.IndexPoint(), walk.Majorant(), scale, ctr);
+  // TentativeCollisionStart's steps, in locals (a member's address kept the
+  // optical depth out of a register: 2 % more instructions in RatioTrack).
+  Ray indexRay;
+  float t0, t1;
+  if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
+  MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, scale);
+  float tau = TentativeCollisionStart::OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
+  RayMajorantSegment seg;
+  while (it.Next(&seg)) {
+    ++ctr.majorantSegments;
     if constexpr (Residual) {
-      if (!visit(c, walk.Segment())) return;
-    } else {
-      if (!visit(walk.T(), c, walk.Segment().sigma_maj)) return;
+      if (Planted(Defect::ShadowLastSegment) && seg.tMax >= t1) return;
+      if (!segment(seg)) return;
+      seg.sigma_maj -= seg.sigma_min;
     }
-    walk.DrawNextArrival(rng);
+    if (seg.sigma_maj <= 0.f) continue;
+    for (float t = seg.tMin;;) {
+      const float tauLeft = (seg.tMax - t) * seg.sigma_maj;  // in this segment
+      if (tau >= tauLeft) {
+        tau -= tauLeft;
+        break;
+      }
+      t += tau / seg.sigma_maj;  // below tMax but for rounding, which lands on this node's face
+      // The point also in proxy 0's index space, from the index ray: the
+      // proxies on proxy 0's grid are sampled there (Classifier::onProxy0Grid).
+      Classification c =
+          LookupAndCount(s, ray(t), indexRay(t), Residual ? seg.sigma_maj + seg.sigma_min : seg.sigma_maj, scale, ctr);
+      if constexpr (Residual) {
+        if (!visit(c, seg)) return;
+      } else {
+        if (!visit(t, c, seg.sigma_maj)) return;
+      }
+      tau = TentativeCollisionStart::OpticalDepthToArrival(rng.Uniform());
+    }
   }
 }
 
@@ -191,26 +155,25 @@ struct DeltaTrackingChoice {
   }
 };
 
-// Delta tracking: the first real collision along ray up to tMax. `first`,
-// when given, holds the uniforms of the first arrival and of its
-// real-or-null choice (a low-discrepancy pair).
+// Delta tracking: a tentative collision is real with probability
+// sigma_t / sigma_maj. `first`, when given, holds the uniforms of the first
+// arrival and of its real-or-null choice (a low-discrepancy pair).
 MMRTM_CPU_GPU inline FreePathResult DeltaTrack(const SceneView& s, const Ray& ray, float tMax, PCG32& rng,
                                                TraceCounters& ctr, const float* first = nullptr) {
   FreePathResult r;
-  TentativeCollisionWalk<false> walk(s, ray, tMax, 1.f);
-  if (!walk.InDomain()) return r;
-  walk.Start(rng, first ? first[0] : -1.f);
   DeltaTrackingChoice choice{first ? first[1] : -1.f};
-  while (walk.Next(ctr)) {
-    const Classification c = LookupAndCount(s, ray(walk.T()), walk.IndexPoint(), walk.Majorant(), 1.f, ctr);
-    if (choice.Real(c.sigma_t, walk.Majorant(), rng, ctr)) {
-      r.collided = true;
-      r.t = walk.T();
-      r.c = c;
-      return r;
-    }
-    walk.DrawNextArrival(rng);
-  }
+  SampleTentativeCollisions(
+      s, ray, tMax, 1.f, rng, ctr,
+      [&](float t, const Classification& c, float sigma_maj) {
+        if (choice.Real(c.sigma_t, sigma_maj, rng, ctr)) {
+          r.collided = true;
+          r.t = t;
+          r.c = c;
+          return false;
+        }
+        return true;
+      },
+      [](const RayMajorantSegment&) { return true; }, first ? first[0] : -1.f);
   return r;
 }
 
