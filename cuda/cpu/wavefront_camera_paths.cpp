@@ -91,17 +91,10 @@ void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& pa
     walks_->Set(i, path.walk.it.GridWalk()->State(), path.walk.tau);
     walking_.push_back(i);
   }
-  const size_t n = walking_.size();
-  collided_.resize(n + 1);
-  t_.resize(n + 1);
-  x_.resize(n + 1);
-  y_.resize(n + 1);
-  z_.resize(n + 1);
   CameraChoices choices(s, paths);
   const GridTraversal traversal =
       s.majorants.kind == MajorantKind::Macrocell ? GridTraversal::Macrocell : GridTraversal::Octree;
-  DeltaTrackWalks(s.classifier, s.majorants.grid, traversal, *walks_, walking_.data(), n, choices, collided_.data(),
-                  t_.data(), x_.data(), y_.data(), z_.data(), lanes);
+  DeltaTrackWalks(s.classifier, s.majorants.grid, traversal, *walks_, walking_.data(), walking_.size(), choices, lanes);
   for (uint32_t i : walking_) paths[i].ctr.majorantSegments += (uint64_t)walks_->segments[i];
 #else
   (void)s;

@@ -1,16 +1,11 @@
-// The first stage of the CPU's SIMD backend (issue 34; decisions.md, "a
-// wavefront of stage queues"): the camera rays of many pixel samples are
-// delta-tracked to their first real collision together, a round at a
-// time. Each round every path still walking advances to its next tentative
-// collision (the majorant walk, per path), the extinctions at all those
-// points are looked up in SIMD lanes (a plain scene: simd/plain_extinction.h;
-// otherwise one Classify a point), and each path makes its real-or-null
-// choice. The walk, the choice and the classification of the real
-// collision are the scalar tracker's own (mmrtm/tracking.h), each path
-// draws its own random numbers in DeltaTrack's order, and the lanes give
-// the scalar lookup's bits, so a path's free path is the one DeltaTrack
-// samples, to the last bit; the rest of the path is the scalar integrator
-// (Li, given the free path).
+// The camera stage of the CPU's SIMD backend (--simd on; issue 34): a
+// batch of pixel samples' camera rays delta-tracked together in SIMD lanes
+// (cuda/simd/grid_walk_lanes.h: the majorant walk and a plain scene's
+// lookups in lanes, a lane a ray), each ray's real-or-null choices made with
+// its own random numbers in DeltaTrack's order, and the real collision
+// classified by the scalar classifier. A path's free path is the one
+// DeltaTrack samples, to the last bit; the rest of the path is the scalar
+// integrator (Li, given the free path: wavefront_tile.h).
 #pragma once
 
 #include <cstdint>
@@ -57,8 +52,6 @@ class WavefrontCameraPaths {
  private:
   std::unique_ptr<GridWalkLanes> walks_;  // the paths' majorant walks, in lanes
   std::vector<uint32_t> walking_;         // the paths in the domain
-  std::vector<int32_t> collided_;         // each walking path: collided (1) or not (0)
-  std::vector<float> t_, x_, y_, z_;      // and where
 };
 
 }  // namespace mmrtm

@@ -292,7 +292,7 @@ HWY_INLINE MF Act(const MajorantGridView& grid, const LevelTables& tables, bool 
 template <typename T, bool Plain>
 void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid, GridTraversal traversal,
                      GridWalkLanes& walks, const uint32_t* ids, size_t count, ArrivalChoices& choices,
-                     int32_t* collided, float* t, float* x, float* y, float* z, LaneCounters* counters) {
+                     LaneCounters* counters) {
   LevelTables tables;
   for (int l = 0; l < kLevelTableSize; ++l) {
     const int used = l <= grid.leafLevel ? l : grid.leafLevel;
@@ -307,52 +307,31 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
   const DF df;
   const DI di;
   const size_t n = hn::Lanes(df);
-  const int32_t scratch = (int32_t)(walks.itT.size() - 1), scratchOut = (int32_t)count;
+  const int32_t scratch = (int32_t)(walks.itT.size() - 1);
   const VF scale = hn::Set(df, 1.f);
-  const VI oneI = hn::Set(di, 1), zeroI = hn::Zero(di);
+  const VI oneI = hn::Set(di, 1), zeroI = hn::Zero(di), scratchI = hn::Set(di, scratch);
   constexpr size_t kMax = HWY_MAX_BYTES / sizeof(float);
-  HWY_ALIGN int32_t laneId[kMax], lanePos[kMax], flag[kMax];
+  HWY_ALIGN int32_t laneId[kMax], flag[kMax];
   HWY_ALIGN float laneT[kMax], px[kMax], py[kMax], pz[kMax], laneMaj[kMax], laneSigma[kMax], laneTau[kMax];
-  for (size_t k = 0; k < n; ++k) {
-    laneId[k] = scratch;
-    lanePos[k] = scratchOut;
-  }
-  VI id = hn::Load(di, laneId), pos = hn::Load(di, lanePos);
+  for (size_t k = 0; k < n; ++k) laneId[k] = scratch;
+  VI id = hn::Load(di, laneId);
   Walks w;
   LoadWalks(tables, walks, id, w);
-  MF live = hn::FirstN(df, 0), collidedLanes = live, free = hn::Not(live);
+  MF live = hn::FirstN(df, 0), free = hn::Not(live);
   size_t next = 0;
   LaneCounters c;
-  // The lanes of `which` out: their walks' state, and whether they
-  // collided and where.
-  auto finish = [&](MF which) {
-    StoreWalks(w, id, walks);
-    const VI out = SelI(which, pos, hn::Set(di, scratchOut));
-    hn::ScatterIndex(SelI(collidedLanes, oneI, zeroI), di, collided, out);
-    hn::ScatterIndex(w.walkT, df, t, out);
-    hn::ScatterIndex(w.o[0] + w.d[0] * w.walkT, df, x, out);
-    hn::ScatterIndex(w.o[1] + w.d[1] * w.walkT, df, y, out);
-    hn::ScatterIndex(w.o[2] + w.d[2] * w.walkT, df, z, out);
-  };
   for (;;) {
-    // Refill when half the lanes are free (the others are stored and
-    // loaded again with the new ones).
+    // Refill when half the lanes are free: every lane's walk stored, the
+    // free lanes given the next walks, all loaded again.
     if (next < count && hn::CountTrue(df, free) * 2 >= n) {
-      finish(free);
+      StoreWalks(w, id, walks);
       hn::Store(id, di, laneId);
-      hn::Store(pos, di, lanePos);
       hn::Store(SelI(free, oneI, zeroI), di, flag);
-      for (size_t k = 0; k < n; ++k) {
-        if (!flag[k]) continue;
-        const bool more = next < count;
-        laneId[k] = more ? (int32_t)ids[next] : scratch;
-        lanePos[k] = more ? (int32_t)next++ : scratchOut;
-      }
+      for (size_t k = 0; k < n; ++k)
+        if (flag[k]) laneId[k] = next < count ? (int32_t)ids[next++] : scratch;
       id = hn::Load(di, laneId);
-      pos = hn::Load(di, lanePos);
       LoadWalks(tables, walks, id, w);
-      live = hn::Or(live, ToF(pos < hn::Set(di, scratchOut)));
-      collidedLanes = hn::AndNot(free, collidedLanes);
+      live = hn::Or(live, hn::And(free, ToF(hn::Not(id == scratchI))));
       free = hn::Not(live);
       ++c.refills;
     }
@@ -385,23 +364,22 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       }
       real = ToF(hn::Load(di, flag) != zeroI);
       w.tau = Sel(hn::AndNot(real, arrived), hn::Load(df, laneTau), w.tau);
-      collidedLanes = hn::Or(collidedLanes, real);
     }
     const MF done = hn::Or(ended, real);
     live = hn::AndNot(done, live);
     free = hn::Or(free, done);
   }
-  finish(free);
+  StoreWalks(w, id, walks);  // the segments counted
   c.lanes = n;
   if (counters) *counters += c;
 }
 
 void DeltaTrackWalksLanes(const Classifier& classifier, const MajorantGridView& grid, GridTraversal traversal,
                           GridWalkLanes& walks, const uint32_t* ids, size_t count, ArrivalChoices& choices,
-                          int32_t* collided, float* t, float* x, float* y, float* z, LaneCounters* counters) {
+                          LaneCounters* counters) {
   auto run = [&](auto voxel, auto plain) {
     DeltaTrackLanes<decltype(voxel), decltype(plain)::value>(classifier, grid, traversal, walks, ids, count, choices,
-                                                             collided, t, x, y, z, counters);
+                                                             counters);
   };
   if (!classifier.plain) return run(float(), std::false_type());
   switch (classifier.proxies[0].type) {
@@ -469,9 +447,9 @@ bool PlainLookupsFit(const Classifier& classifier) {
 
 void DeltaTrackWalks(const Classifier& classifier, const MajorantGridView& grid, GridTraversal traversal,
                      GridWalkLanes& walks, const uint32_t* ids, size_t count, ArrivalChoices& choices,
-                     int32_t* collided, float* t, float* x, float* y, float* z, LaneCounters* counters) {
+                     LaneCounters* counters) {
   HWY_DYNAMIC_DISPATCH(DeltaTrackWalksLanes)
-  (classifier, grid, traversal, walks, ids, count, choices, collided, t, x, y, z, counters);
+  (classifier, grid, traversal, walks, ids, count, choices, counters);
 }
 
 }  // namespace mmrtm

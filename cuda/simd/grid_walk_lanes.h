@@ -58,12 +58,11 @@ class ArrivalChoices {
 // true for a scene that is not plain: the caller looks up).
 bool PlainLookupsFit(const Classifier& classifier);
 
-// Delta-tracks walks ids[0..count) to their first real collision or their
-// end (DeltaTrack's walk and choices): collided[k] is 1 and (t, x, y,
-// z)[k] the collision's distance and index point, or collided[k] is 0.
-// The output arrays hold count + 1 values (the last is scratch).
+// Delta-tracks walks ids[0..count) to their first real collision (which
+// `choices` records) or their end, as DeltaTrack's walk; adds to `counters`
+// (null: none).
 void DeltaTrackWalks(const Classifier& classifier, const MajorantGridView& grid, GridTraversal traversal,
                      GridWalkLanes& walks, const uint32_t* ids, size_t count, ArrivalChoices& choices,
-                     int32_t* collided, float* t, float* x, float* y, float* z, LaneCounters* counters);
+                     LaneCounters* counters);
 
 }  // namespace mmrtm

@@ -80,7 +80,7 @@ MMRTM_CPU_GPU inline uint8_t EncodeMinorant(float majorant, float minorant) {
 struct GridWalkState {
   Vec3 o, d;  // the ray in index space
   float invD[3], tClip[3], tFace[3];
-  float t, tEnd, scale;
+  float t, tEnd;
   int level, cell[3], step[3];
   int64_t node;
 };
@@ -128,12 +128,10 @@ class GridMajorantIterator {
     }
     s.t = t_;
     s.tEnd = tEnd_;
-    s.scale = scale_;
     s.level = level_;
     s.node = node_;
     return s;
   }
-  MMRTM_CPU_GPU GridTraversal Traversal() const { return traversal_; }
 
   // The next segment with a non-zero majorant, and a lower bound of the
   // extinction over it (0 without minorants); false at the end of the ray.

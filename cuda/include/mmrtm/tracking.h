@@ -33,13 +33,13 @@ struct FreePathResult {
   Classification c;
 };
 
-// Classifies p (`index0`: p in proxy 0's index space), counting the lookup,
-// and a violation if the (scaled) extinction there exceeds the majorant that
-// the tracker was given.
+// Counts a lookup, and a violation if the (scaled) extinction there exceeds
+// the majorant that the tracker was given.
 MMRTM_CPU_GPU inline void CountLookup(float sigma_t, float sigma_maj, float scale, TraceCounters& ctr) {
   ++ctr.densityLookups;
   if (scale * sigma_t > sigma_maj * 1.0001f) ++ctr.majorantViolations;
 }
+// Classifies p (`index0`: p in proxy 0's index space), counting the lookup.
 MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, Vec3 index0, float sigma_maj,
                                                    float scale, TraceCounters& ctr) {
   Classification c = s.classifier.Classify(p, index0);
@@ -100,8 +100,8 @@ template <bool Residual = false, typename Visit, typename Segment>
 MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
                                                     PCG32& rng, TraceCounters& ctr, Visit visit, Segment segment,
                                                     float uFirst = -1.f) {
-  // TentativeCollisionStart's steps, in locals (a member's address kept the
-  // optical depth out of a register: 2 % more instructions in RatioTrack).
+  // TentativeCollisionStart's steps in locals, which stay in registers
+  // (through the struct, RatioTrack ran 2 % more instructions).
   Ray indexRay;
   float t0, t1;
   if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
