@@ -32,7 +32,13 @@ int main(int argc, char** argv) {
       size = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--spp") && i + 1 < argc)
       spp = std::atoi(argv[++i]);
-    else
+    else if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+      std::printf("mmrtm-bench-plain-scene [VOLUME] [--size N] [--spp N]\n");
+      return 0;
+    } else if (argv[i][0] == '-') {
+      std::fprintf(stderr, "mmrtm-bench-plain-scene: unknown option %s\n", argv[i]);
+      return 2;
+    } else
       volume = argv[i];
   }
   try {

@@ -62,18 +62,7 @@ TEST(Determinism, PlainScenePathEqualsTheGeneralPath) {
   EXPECT_EQ(0, std::memcmp(shortest.data(), general.data(), shortest.size() * sizeof(float)));
   // A second material, chosen by an MDPTF over a label proxy, makes it not plain.
   Scene labelled = MakeScene();
-  labelled.proxies.push_back(test::MakeVolume(
-      12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
-  labelled.materials.push_back(labelled.materials[0]);
-  labelled.materials[1].name = "other";
-  TransferFunctionDesc selector;
-  selector.where = "test";
-  selector.type = TFType::MDPTF;
-  selector.proxy = 1;
-  selector.keys = {1.f};
-  selector.materials = {1};
-  labelled.tfs.push_back(selector);
-  labelled.selectors.push_back((int)labelled.tfs.size() - 1);
+  test::AddLabelledSecondMaterial(labelled);
   EXPECT_FALSE(labelled.Build().classifier.plain);
 }
 

@@ -68,4 +68,21 @@ inline Scene MakeMediumScene(HostVolume volume, float density, RGB albedo, float
   return s;
 }
 
+// Makes `s` (a 12^3 scene of one material) not plain: a label proxy whose
+// label 1 (every other x slab) picks a copy of material 0 named "other".
+inline void AddLabelledSecondMaterial(Scene& s) {
+  s.proxies.push_back(MakeVolume(
+      12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
+  s.materials.push_back(s.materials[0]);
+  s.materials.back().name = "other";
+  TransferFunctionDesc selector;
+  selector.where = "test";
+  selector.type = TFType::MDPTF;
+  selector.proxy = (int)s.proxies.size() - 1;
+  selector.keys = {1.f};
+  selector.materials = {(int)s.materials.size() - 1};
+  s.tfs.push_back(selector);
+  s.selectors.push_back((int)s.tfs.size() - 1);
+}
+
 }  // namespace mmrtm::test

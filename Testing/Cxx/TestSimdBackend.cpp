@@ -16,13 +16,15 @@
 // first arrival's Sobol' pair ignored, the batch of 1024 paths made 1000
 // (pixels then straddle batches; still equal: the order is kept).
 // The statistical comparison of the two backends on the five reference
-// scenes is Testing/Accuracy/test_simd_backend.py.
+// scenes is Testing/Accuracy/test_simd_backend.py; the failure-case scenes
+// (FailureCaseScenes.h) are compared here, to the bit.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include "FailureCaseScenes.h"
 #include "TestSceneHelpers.h"
 #include "TestTypedVolumes.h"
 #include "cpu_renderer.h"
@@ -156,19 +158,8 @@ TEST(SimdBackend, SceneNotPlainWalksInLanesAndClassifiesOnePointAtATime) {
   // A label proxy choosing a second material (as TestDeterminism): the
   // walk runs in lanes, the lookups are the classifier's.
   Scene scene = MakeFloatScene();
-  scene.proxies.push_back(test::MakeVolume(
-      12, 12, 12, [](int i, int, int) { return (float)(i % 2); }, 1.f, "labels"));
-  scene.materials.push_back(scene.materials[0]);
-  scene.materials[1].name = "other";
+  test::AddLabelledSecondMaterial(scene);
   scene.materials[1].base[1] = 0.2f;
-  TransferFunctionDesc selector;
-  selector.where = "test";
-  selector.type = TFType::MDPTF;
-  selector.proxy = 1;
-  selector.keys = {1.f};
-  selector.materials = {1};
-  scene.tfs.push_back(selector);
-  scene.selectors.push_back((int)scene.tfs.size() - 1);
   const SceneView view = scene.Build();
   ASSERT_FALSE(view.classifier.plain);
   const Image simd = ExpectSameImage(view, "two materials");
@@ -216,6 +207,25 @@ TEST(SimdBackend, AdaptiveSamplingAndBatchesThatSplitPixels) {
   Scene scene = MakeFloatScene();
   ExpectSameImage(scene.Build(), "adaptive", 7, true);
   ExpectSameImage(scene.Build(), "many samples", 61);
+}
+
+TEST(SimdBackend, FailureCaseScenes) {
+  // The scenes where trackers fail (TestFailureCases): a TF peak narrower
+  // than a voxel, a sparse block, a sheet on a node face, a step at the
+  // data maximum, all-zero and all-one TFs; on both grids.
+  for (MajorantKind kind : {MajorantKind::Octree, MajorantKind::Macrocell}) {
+    std::vector<std::pair<std::string, failure::Case>> cases;
+    cases.emplace_back("narrow peak", failure::NarrowPeak(0.05f, 40.f, kind, SummaryMode::CellRanges));
+    cases.emplace_back("sparse block", failure::SparseBlock(32, 2.f, kind));
+    cases.emplace_back("sheet on a node face", failure::SliceSheet(16.f, 1.f, kind, 0.3f));
+    cases.emplace_back("saturated block", failure::SaturatedBlock(2.f, kind));
+    cases.emplace_back("all-zero TF", failure::AllZeroTF(kind));
+    cases.emplace_back("all-one TF", failure::AllOneTF(kind));
+    for (auto& [name, c] : cases) {
+      c.scene.environment = EnvironmentMap::DefaultSky();
+      ExpectSameImage(c.scene.Build(), name + (kind == MajorantKind::Octree ? ", octree" : ", macrocell"));
+    }
+  }
 }
 
 TEST(SimdBackend, SameImageAtAnyThreadCount) {
