@@ -56,7 +56,6 @@ HWY_FLATTEN void PlainExtinctionLanes(const Classifier& classifier, const float*
 }
 
 const char* TargetNameLanes() { return hwy::TargetName(HWY_TARGET); }
-size_t LaneCountLanes() { return hn::Lanes(DF()); }
 
 }  // namespace HWY_NAMESPACE
 }  // namespace mmrtm
@@ -67,7 +66,6 @@ namespace mmrtm {
 
 HWY_EXPORT(PlainExtinctionLanes);
 HWY_EXPORT(TargetNameLanes);
-HWY_EXPORT(LaneCountLanes);
 
 void PlainExtinctionSimd(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
                          float* sigma_t) {
@@ -91,7 +89,6 @@ void PlainExtinctionScalar(const Classifier& classifier, const float* x, const f
 }
 
 const char* PlainExtinctionTarget() { return HWY_DYNAMIC_DISPATCH(TargetNameLanes)(); }
-size_t PlainExtinctionLaneCount() { return HWY_DYNAMIC_DISPATCH(LaneCountLanes)(); }
 
 }  // namespace mmrtm
 #endif  // HWY_ONCE

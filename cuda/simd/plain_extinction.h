@@ -30,9 +30,7 @@ void PlainExtinctionSimd(const Classifier& classifier, const float* x, const flo
 void PlainExtinctionScalar(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
                            float* sigma_t);
 
-// The Highway target that PlainExtinctionSimd runs on now ("AVX3", "AVX2", ...),
-// and its number of float lanes.
+// The Highway target that PlainExtinctionSimd runs on now ("AVX3", "AVX2", ...).
 const char* PlainExtinctionTarget();
-size_t PlainExtinctionLaneCount();
 
 }  // namespace mmrtm
