@@ -23,7 +23,7 @@ namespace mmrtm {
 // lanes (wavefront_camera_paths.h). Off: the scalar backend. Both give the
 // same image to the last bit. Auto: the faster of the two for the scene,
 // which is the scalar backend on every scene measured so far (the lanes
-// took 0.99-1.05 times its time: Documentation/performance.md, "SIMD
+// took 0.96-1.04 times its time: Documentation/performance.md, "SIMD
 // lanes: the camera stage"), so that no user pays for lanes that do not
 // pay yet.
 enum class SimdMode { Off, Auto, On };

@@ -34,6 +34,7 @@ constexpr int kLevelTableSize = kMaxGridLevels + HWY_MAX_BYTES / 4;
 struct LevelTables {
   int32_t nodeSize[kLevelTableSize], res[3][kLevelTableSize], offset[kLevelTableSize];
   float worldWidth[kLevelTableSize];
+  float cells[3];  // voxel cells per axis (the grid's end)
 };
 
 // table[level] in each lane: in-register permutes of the small table
@@ -61,45 +62,51 @@ HWY_INLINE VF MaxF(VF a, VF b) { return hn::IfThenElse(a > b, a, b); }
 HWY_INLINE VI GatherI(const int32_t* base, VI index) { return hn::GatherIndex(DI(), base, index); }
 HWY_INLINE VF GatherF(const float* base, VI index) { return hn::GatherIndex(DF(), base, index); }
 
-// The lanes' walks (GridWalkLanes' fields, one lane a walk), with what the
-// scalar iterator derives from its level: node size and index strides.
+// The lanes' walks (GridWalkLanes' fields, one lane a walk). What the
+// scalar iterator keeps beside them (its step per axis, node size and index
+// strides) is derived when needed: fewer vectors live across the loop.
 struct Walks {
-  VF o[3], d[3], invD[3], tClip[3], tFace[3];
-  VF itT, tEnd, walkT, tau, segTMax, segMaj, size;
-  VI cell[3], step[3], level, node, stride[3], segments;
+  VF o[3], d[3], invD[3], tFace[3];
+  VF itT, tEnd, walkT, tau, segTMax, segMaj;
+  VI cell[3], level, node, segments;
   MF inSegment, emptyClimb;
 };
 
-// GridMajorantIterator::FaceAhead(a) for the lanes' current nodes.
-HWY_INLINE VF FaceAhead(const Walks& w, int a) {
-  const VI one = hn::Set(DI(), 1), zero = hn::Zero(DI());
-  const VI ahead = w.cell[a] + hn::IfThenElse(w.step[a] > zero, one, zero);
-  const VF plane = hn::ConvertTo(DF(), ahead) * w.size;
-  const VF t = MinF((plane - w.o[a]) * w.invD[a], w.tClip[a]);
-  return hn::IfThenElse(ToF(w.step[a] == zero), hn::Set(DF(), std::numeric_limits<float>::infinity()), t);
+// GridMajorantIterator's step_[a]: +1, -1 or 0, the ray's direction.
+HWY_INLINE VI StepOf(const Walks& w, int a) {
+  const VI up = hn::Set(DI(), 1), down = hn::Set(DI(), -1), zero = hn::Zero(DI());
+  return hn::IfThenElse(hn::RebindMask(DI(), w.d[a] > hn::Zero(DF())), up,
+                        hn::IfThenElse(hn::RebindMask(DI(), w.d[a] < hn::Zero(DF())), down, zero));
+}
+// The node size (voxel cells) and the index stride along axis a of a level.
+HWY_INLINE VF SizeOf(const LevelTables& tables, VI level) {
+  return hn::ConvertTo(DF(), LevelI(tables.nodeSize, level));
+}
+HWY_INLINE VI StrideOf(const LevelTables& tables, VI level, int a) {
+  if (a == 0) return hn::Set(DI(), 1);
+  const VI res0 = LevelI(tables.res[0], level);
+  return a == 1 ? res0 : res0 * LevelI(tables.res[1], level);
 }
 
-// The node size and strides of each lane's level.
-HWY_INLINE void LevelGeometry(const LevelTables& tables, Walks& w) {
-  w.size = hn::ConvertTo(DF(), LevelI(tables.nodeSize, w.level));
-  w.stride[0] = hn::Set(DI(), 1);
-  w.stride[1] = LevelI(tables.res[0], w.level);
-  w.stride[2] = w.stride[1] * LevelI(tables.res[1], w.level);
+// GridMajorantIterator::FaceAhead(a) for the lanes' current nodes.
+HWY_INLINE VF FaceAhead(const LevelTables& tables, const Walks& w, int a) {
+  const VI one = hn::Set(DI(), 1), zero = hn::Zero(DI()), step = StepOf(w, a);
+  const VI ahead = w.cell[a] + hn::IfThenElse(step > zero, one, zero);
+  const VF plane = hn::ConvertTo(DF(), ahead) * SizeOf(tables, w.level);
+  // tClip_[a]: where the ray leaves the grid's last cell ahead.
+  const VF inf = hn::Set(DF(), std::numeric_limits<float>::infinity());
+  const VF tClip = hn::IfThenElse(w.d[a] > hn::Zero(DF()), (hn::Set(DF(), tables.cells[a]) - w.o[a]) * w.invD[a], inf);
+  const VF t = MinF((plane - w.o[a]) * w.invD[a], tClip);
+  return hn::IfThenElse(ToF(step == zero), inf, t);
 }
 
 // GridMajorantIterator::EnterLevel in the lanes of `m` (their level and
 // cells set already).
 HWY_INLINE void EnterLevel(const LevelTables& tables, MF m, Walks& w) {
-  Walks entered = w;
-  LevelGeometry(tables, entered);
-  entered.node = LevelI(tables.offset, w.level) + w.cell[0] +
-                 entered.stride[1] * (w.cell[1] + LevelI(tables.res[1], w.level) * w.cell[2]);
-  w.size = Sel(m, entered.size, w.size);
-  w.node = SelI(m, entered.node, w.node);
-  for (int a = 0; a < 3; ++a) {
-    w.stride[a] = SelI(m, entered.stride[a], w.stride[a]);
-    w.tFace[a] = Sel(m, FaceAhead(entered, a), w.tFace[a]);
-  }
+  const VI node = LevelI(tables.offset, w.level) + w.cell[0] +
+                  LevelI(tables.res[0], w.level) * (w.cell[1] + LevelI(tables.res[1], w.level) * w.cell[2]);
+  w.node = SelI(m, node, w.node);
+  for (int a = 0; a < 3; ++a) w.tFace[a] = Sel(m, FaceAhead(tables, w, a), w.tFace[a]);
 }
 
 // GridMajorantIterator::ExitDistance: where each lane leaves its node, and
@@ -125,13 +132,14 @@ HWY_INLINE MF Step(const LevelTables& tables, MF m, VI axis, VF tExit, Walks& w)
   for (int a = 0; a < 3; ++a) {
     const MF along = hn::And(go, ToF(axis == hn::Set(DI(), a)));
     if (hn::AllFalse(DF(), along)) continue;
-    const VI next = w.cell[a] + w.step[a];
+    const VI step = StepOf(w, a);
+    const VI next = w.cell[a] + step;
     const MF out = ToF(hn::Or(next < hn::Zero(DI()), hn::Not(next < LevelI(tables.res[a], w.level))));
     w.cell[a] = SelI(along, next, w.cell[a]);
     fail = hn::Or(fail, hn::And(along, out));
     const MF in = hn::AndNot(out, along);
-    w.node = SelI(in, w.node + w.step[a] * w.stride[a], w.node);
-    w.tFace[a] = Sel(in, FaceAhead(w, a), w.tFace[a]);
+    w.node = SelI(in, w.node + step * StrideOf(tables, w.level, a), w.node);
+    w.tFace[a] = Sel(in, FaceAhead(tables, w, a), w.tFace[a]);
     moved = hn::Or(moved, in);
   }
   w.itT = Sel(fail, w.tEnd, w.itT);
@@ -167,16 +175,14 @@ HWY_INLINE void Climb(const LevelTables& tables, MF m, Walks& w) {
 }
 
 // Loads the walks `id` into lanes.
-HWY_INLINE void LoadWalks(const LevelTables& tables, const GridWalkLanes& walks, VI id, Walks& w) {
+HWY_INLINE void LoadWalks(const GridWalkLanes& walks, VI id, Walks& w) {
   const VI zero = hn::Zero(DI());
   for (int a = 0; a < 3; ++a) {
     w.o[a] = GatherF(walks.o[a].data(), id);
     w.d[a] = GatherF(walks.d[a].data(), id);
     w.invD[a] = GatherF(walks.invD[a].data(), id);
-    w.tClip[a] = GatherF(walks.tClip[a].data(), id);
     w.tFace[a] = GatherF(walks.tFace[a].data(), id);
     w.cell[a] = GatherI(walks.cell[a].data(), id);
-    w.step[a] = GatherI(walks.step[a].data(), id);
   }
   w.itT = GatherF(walks.itT.data(), id);
   w.tEnd = GatherF(walks.tEnd.data(), id);
@@ -189,7 +195,6 @@ HWY_INLINE void LoadWalks(const LevelTables& tables, const GridWalkLanes& walks,
   w.segments = GatherI(walks.segments.data(), id);
   w.inSegment = ToF(GatherI(walks.inSegment.data(), id) != zero);
   w.emptyClimb = ToF(GatherI(walks.emptyClimb.data(), id) != zero);
-  LevelGeometry(tables, w);
 }
 
 // Stores what a walk changes of the lanes' walks `id`.
@@ -301,6 +306,7 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
     tables.offset[l] = (int32_t)grid.offset[used];
     tables.worldWidth[l] = grid.worldWidth[used];
   }
+  for (int a = 0; a < 3; ++a) tables.cells[a] = (float)grid.cells[a];
   const std::optional<PlainScene<T>> scene =
       Plain ? std::optional<PlainScene<T>>(std::in_place, classifier) : std::nullopt;
   const bool octree = traversal == GridTraversal::Octree;
@@ -316,7 +322,7 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
   for (size_t k = 0; k < n; ++k) laneId[k] = scratch;
   VI id = hn::Load(di, laneId);
   Walks w;
-  LoadWalks(tables, walks, id, w);
+  LoadWalks(walks, id, w);
   MF live = hn::FirstN(df, 0), free = hn::Not(live);
   size_t next = 0;
   LaneCounters c;
@@ -330,7 +336,7 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       for (size_t k = 0; k < n; ++k)
         if (flag[k]) laneId[k] = next < count ? (int32_t)ids[next++] : scratch;
       id = hn::Load(di, laneId);
-      LoadWalks(tables, walks, id, w);
+      LoadWalks(walks, id, w);
       live = hn::Or(live, hn::And(free, ToF(hn::Not(id == scratchI))));
       free = hn::Not(live);
       ++c.refills;
@@ -405,9 +411,8 @@ HWY_EXPORT(DeltaTrackWalksLanes);
 
 void GridWalkLanes::Resize(size_t n) {
   for (int a = 0; a < 3; ++a)
-    for (auto* v : {&o[a], &d[a], &invD[a], &tClip[a], &tFace[a]}) v->assign(n + 1, 0.f);
-  for (int a = 0; a < 3; ++a)
-    for (auto* v : {&cell[a], &step[a]}) v->assign(n + 1, 0);
+    for (auto* v : {&o[a], &d[a], &invD[a], &tFace[a]}) v->assign(n + 1, 0.f);
+  for (int a = 0; a < 3; ++a) cell[a].assign(n + 1, 0);
   for (auto* v : {&itT, &tEnd, &walkT, &tau, &segTMax, &segMaj}) v->assign(n + 1, 0.f);
   for (auto* v : {&level, &node, &inSegment, &emptyClimb, &segments}) v->assign(n + 1, 0);
 }
@@ -417,10 +422,8 @@ void GridWalkLanes::Set(size_t i, const GridWalkState& s, float walkTau) {
     o[a][i] = s.o[a];
     d[a][i] = s.d[a];
     invD[a][i] = s.invD[a];
-    tClip[a][i] = s.tClip[a];
     tFace[a][i] = s.tFace[a];
     cell[a][i] = s.cell[a];
-    step[a][i] = s.step[a];
   }
   itT[i] = s.t;
   tEnd[i] = s.tEnd;

@@ -24,10 +24,10 @@ namespace mmrtm {
 // The walks' state in structure-of-arrays form: slot i is walk i; the
 // slot after the last is scratch, where padded lanes read and write.
 struct GridWalkLanes {
-  std::vector<float> o[3], d[3], invD[3], tClip[3], tFace[3];
+  std::vector<float> o[3], d[3], invD[3], tFace[3];
   std::vector<float> itT, tEnd;                    // the grid walk's distance and end
   std::vector<float> walkT, tau, segTMax, segMaj;  // SampleTentativeCollisions' (the arrival's t, ...)
-  std::vector<int32_t> cell[3], step[3], level, node;
+  std::vector<int32_t> cell[3], level, node;
   std::vector<int32_t> inSegment, emptyClimb;  // 0 or 1 (-1 in lanes)
   std::vector<int32_t> segments;               // majorant segments handed out, a count per walk
 

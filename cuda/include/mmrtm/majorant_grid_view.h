@@ -75,13 +75,14 @@ MMRTM_CPU_GPU inline uint8_t EncodeMinorant(float majorant, float minorant) {
   return (uint8_t)q;
 }
 
-// The state of a walk over the grid (GridMajorantIterator's), for the SIMD
-// walk that continues many of them in lanes (cuda/simd/grid_walk_lanes.h).
+// The state of a walk over the grid (GridMajorantIterator's, less what
+// follows from the ray and the level), for the SIMD walk that continues
+// many of them in lanes (cuda/simd/grid_walk_lanes.h).
 struct GridWalkState {
   Vec3 o, d;  // the ray in index space
-  float invD[3], tClip[3], tFace[3];
+  float invD[3], tFace[3];
   float t, tEnd;
-  int level, cell[3], step[3];
+  int level, cell[3];
   int64_t node;
 };
 
@@ -121,10 +122,8 @@ class GridMajorantIterator {
     s.d = d_;
     for (int a = 0; a < 3; ++a) {
       s.invD[a] = invD_[a];
-      s.tClip[a] = tClip_[a];
       s.tFace[a] = tFace_[a];
       s.cell[a] = cell_[a];
-      s.step[a] = step_[a];
     }
     s.t = t_;
     s.tEnd = tEnd_;
