@@ -23,9 +23,9 @@ class WavefrontTile {
   void Render(const SceneView& s, const Film& film, const FilmView& view, int x0, int y0, int x1, int y1,
               const std::function<uint32_t(size_t, uint32_t)>& end, TraceCounters& ctr, LaneCounters* lanes);
 
-  // Paths tracked together: enough to keep the lanes full through most
-  // rounds, few enough for their state (about 0.4 KiB each) to stay in
-  // the core's L2 cache.
+  // Paths tracked together: enough that the lanes, refilled as rays
+  // collide, stay full but for the batch's last rays; few enough for their
+  // state (about 0.4 KiB each) to stay in the core's L2 cache.
   static constexpr size_t kBatchPaths = 1024;
 
  private:
