@@ -27,18 +27,8 @@ std::vector<float> Render(Scene& scene, int threads, uint64_t seed, int passes, 
 }
 
 Scene MakeScene() {
-  Scene scene =
-      test::MakeMediumScene(test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }),
-                            1.f, RGB(0.9f, 0.7f, 0.5f), 0.3f);
-  scene.materials[0].base[6] = 0.5f;  // half the collisions scatter on the surface BSDF
-  scene.environment = EnvironmentMap::DefaultSky();
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.vector = Normalize(Vec3{1.f, -1.f, 2.f});
-  sun.L = RGB(2.f);
-  scene.lights.push_back(sun);
-  scene.render.integrator.shadowExtinctionScale = 0.8f;
-  return scene;
+  return test::MakeLitSurfaceScene(
+      test::MakeVolume(12, 12, 12, [](int i, int j, int k) { return (i * j + k) % 5 / 4.f; }));
 }
 
 TEST(Determinism, ThreadCountDoesNotChangeTheImage) {

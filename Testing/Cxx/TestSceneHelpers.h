@@ -68,6 +68,22 @@ inline Scene MakeMediumScene(HostVolume volume, float density, RGB albedo, float
   return s;
 }
 
+// A lit scene over `volume` (TestDeterminism's, TestSimdBackend's): the
+// medium of MakeMediumScene with albedo (0.9, 0.7, 0.5) and g 0.3, half the
+// collisions on the surface BSDF, a sky and a sun, the shadow scale 0.8.
+inline Scene MakeLitSurfaceScene(HostVolume volume) {
+  Scene s = MakeMediumScene(std::move(volume), 1.f, RGB(0.9f, 0.7f, 0.5f), 0.3f);
+  s.materials[0].base[6] = 0.5f;  // half the collisions scatter on the surface BSDF
+  s.environment = EnvironmentMap::DefaultSky();
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.vector = Normalize(Vec3{1.f, -1.f, 2.f});
+  sun.L = RGB(2.f);
+  s.lights.push_back(sun);
+  s.render.integrator.shadowExtinctionScale = 0.8f;
+  return s;
+}
+
 // Makes `s` (a 12^3 scene of one material) not plain: a label proxy whose
 // label 1 (every other x slab) picks a copy of material 0 named "other".
 inline void AddLabelledSecondMaterial(Scene& s) {

@@ -66,19 +66,10 @@ double Sum(const Image& image) {
   return sum;
 }
 
-// The TestDeterminism scene: a float medium, half the collisions on the
-// surface BSDF, a sky and a sun, the shadow scale 0.8.
+// TestDeterminism's lit scene, at Render's film size.
 Scene MakeScene(HostVolume volume) {
-  Scene scene = test::MakeMediumScene(std::move(volume), 1.f, RGB(0.9f, 0.7f, 0.5f), 0.3f);
-  scene.materials[0].base[6] = 0.5f;
-  scene.environment = EnvironmentMap::DefaultSky();
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.vector = Normalize(Vec3{1.f, -1.f, 2.f});
-  sun.L = RGB(2.f);
-  scene.lights.push_back(sun);
-  scene.render.integrator.shadowExtinctionScale = 0.8f;
-  scene.render.width = 37;  // Render's film
+  Scene scene = test::MakeLitSurfaceScene(std::move(volume));
+  scene.render.width = 37;
   scene.render.height = 23;
   return scene;
 }

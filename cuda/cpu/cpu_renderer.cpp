@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -90,13 +91,13 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   const bool wavefront = UsesSimd(s);
   auto worker = [&](int thread) {
     TraceCounters& ctr = perThread[thread];
-    WavefrontTile wavefrontTile;
+    const std::unique_ptr<WavefrontTile> wavefrontTile = wavefront ? std::make_unique<WavefrontTile>() : nullptr;
     for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
       if (cancel && cancel->load(std::memory_order_relaxed)) break;
       const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
       const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
       if (wavefront) {
-        wavefrontTile.Render(s, film, view, x0, y0, x1, y1, end, ctr, &lanesPerThread[thread]);
+        wavefrontTile->Render(s, film, view, x0, y0, x1, y1, end, ctr, &lanesPerThread[thread]);
       } else {
         for (int y = y0; y < y1; ++y)
           for (int x = x0; x < x1; ++x) {

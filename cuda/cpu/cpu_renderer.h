@@ -35,7 +35,6 @@ class CpuRenderer {
   // environment's MMRTM_CPU_SIMD (on, off) where it is set.
   explicit CpuRenderer(int threads = 0, SimdMode simd = SimdMode::Auto);
   int Threads() const { return threads_; }
-  SimdMode Simd() const { return simd_; }
   // Whether a render of `scene` runs the SIMD backend.
   bool UsesSimd(const SceneView& scene) const;
   // "cpu, 2 thread(s), SIMD AVX3" (or "scalar").
