@@ -17,6 +17,7 @@
 // (AVX2 at best: Valgrind has no AVX-512).
 //
 //   mmrtm-bench-simd-camera-paths [VOLUME] [--size N] [--spp N] [--rounds N] [--only scalar|AVX3|AVX2|...]
+//                                 [--accelerator octree|macrocell]
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -87,7 +88,7 @@ void Record(const mmrtm::FreePathResult& fp, size_t i, FreePaths* out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string volume = std::string(MMRTM_SHARED_DATA_DIR) + "/ct_head_cranium.nrrd", only;
+  std::string volume = std::string(MMRTM_SHARED_DATA_DIR) + "/ct_head_cranium.nrrd", only, accelerator = "octree";
   int size = 256, spp = 4, rounds = 5;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -99,8 +100,12 @@ int main(int argc, char** argv) {
       rounds = std::atoi(argv[++i]);
     else if (a == "--only" && i + 1 < argc)
       only = argv[++i];
+    else if (a == "--accelerator" && i + 1 < argc)
+      accelerator = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("mmrtm-bench-simd-camera-paths [VOLUME] [--size N] [--spp N] [--rounds N] [--only MODE]\n");
+      std::printf(
+          "mmrtm-bench-simd-camera-paths [VOLUME] [--size N] [--spp N] [--rounds N] [--only MODE] "
+          "[--accelerator octree|macrocell]\n");
       return 0;
     } else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "mmrtm-bench-simd-camera-paths: unknown option %s\n", a.c_str());
@@ -109,7 +114,12 @@ int main(int argc, char** argv) {
       volume = a;
   }
   try {
-    mmrtm::Scene scene = PlainCtBoneScene(volume, size);
+    if (accelerator != "octree" && accelerator != "macrocell") {
+      std::fprintf(stderr, "mmrtm-bench-simd-camera-paths: --accelerator is octree or macrocell, not %s\n",
+                   accelerator.c_str());
+      return 2;
+    }
+    mmrtm::Scene scene = PlainCtBoneScene(volume, size, accelerator);
     mmrtm::SceneView view = scene.Build();
     view.camera.width = size;
     view.camera.height = size;
@@ -154,8 +164,9 @@ int main(int argc, char** argv) {
       }
       mmrtm::ForceSimdTarget(0);
     }
-    std::printf("{\"paths\": %zu, \"lookups_per_path\": %.3f, \"segments_per_path\": %.3f,\n", n,
-                (double)reference_ctr.densityLookups / n, (double)reference_ctr.majorantSegments / n);
+    std::printf("{\"accelerator\": \"%s\", \"paths\": %zu, \"lookups_per_path\": %.3f, \"segments_per_path\": %.3f,\n",
+                accelerator.c_str(), n, (double)reference_ctr.densityLookups / n,
+                (double)reference_ctr.majorantSegments / n);
     const bool scalar_ran = best_scalar < 1e30;  // not with --only a target
     std::printf(" \"scalar_ns_per_path\": %.1f,\n \"lanes\": [\n", scalar_ran ? best_scalar * 1e9 / n : 0.0);
     for (size_t k = 0; k < targets.size(); ++k) {

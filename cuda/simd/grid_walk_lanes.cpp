@@ -42,6 +42,7 @@ struct LevelTables {
 template <class D>
 HWY_INLINE hn::Vec<D> ByLevel(D d, const hn::TFromD<D>* table, hn::Vec<DI> level) {
   const int n = (int)hn::Lanes(d);
+  if (n >= kMaxGridLevels) return hn::TableLookupLanes(hn::LoadU(d, table), hn::IndicesFromVec(d, level));
   hn::Vec<D> value = hn::Zero(d);
   for (int first = 0; first < kMaxGridLevels; first += n) {
     const hn::Vec<DI> index = hn::Min(hn::Max(level - hn::Set(DI(), first), hn::Zero(DI())), hn::Set(DI(), n - 1));
@@ -69,44 +70,48 @@ struct Walks {
   VF o[3], d[3], invD[3], tFace[3];
   VF itT, tEnd, walkT, tau, segTMax, segMaj;
   VI cell[3], level, node, segments;
-  MF inSegment, emptyClimb;
+  MF inSegment;
 };
 
-// GridMajorantIterator's step_[a]: +1, -1 or 0, the ray's direction.
-HWY_INLINE VI StepOf(const Walks& w, int a) {
-  const VI up = hn::Set(DI(), 1), down = hn::Set(DI(), -1), zero = hn::Zero(DI());
-  return hn::IfThenElse(hn::RebindMask(DI(), w.d[a] > hn::Zero(DF())), up,
-                        hn::IfThenElse(hn::RebindMask(DI(), w.d[a] < hn::Zero(DF())), down, zero));
-}
-// The node size (voxel cells) and the index stride along axis a of a level.
-HWY_INLINE VF SizeOf(const LevelTables& tables, VI level) {
-  return hn::ConvertTo(DF(), LevelI(tables.nodeSize, level));
-}
-HWY_INLINE VI StrideOf(const LevelTables& tables, VI level, int a) {
-  if (a == 0) return hn::Set(DI(), 1);
-  const VI res0 = LevelI(tables.res[0], level);
-  return a == 1 ? res0 : res0 * LevelI(tables.res[1], level);
+// A level's numbers in each lane, looked up once an action: the node size
+// (voxel cells) and the grid's resolution per axis.
+struct LevelNumbers {
+  VF size;
+  VI res[3];
+};
+HWY_INLINE LevelNumbers NumbersOf(const LevelTables& tables, VI level) {
+  return {hn::ConvertTo(DF(), LevelI(tables.nodeSize, level)),
+          {LevelI(tables.res[0], level), LevelI(tables.res[1], level), LevelI(tables.res[2], level)}};
 }
 
-// GridMajorantIterator::FaceAhead(a) for the lanes' current nodes.
-HWY_INLINE VF FaceAhead(const LevelTables& tables, const Walks& w, int a) {
-  const VI one = hn::Set(DI(), 1), zero = hn::Zero(DI()), step = StepOf(w, a);
-  const VI ahead = w.cell[a] + hn::IfThenElse(step > zero, one, zero);
-  const VF plane = hn::ConvertTo(DF(), ahead) * SizeOf(tables, w.level);
+// GridMajorantIterator's step_[a]: +1, -1 or 0, the direction d.
+HWY_INLINE VI StepOf(VF d) {
+  const VI up = hn::Set(DI(), 1), down = hn::Set(DI(), -1), zero = hn::Zero(DI());
+  return hn::IfThenElse(hn::RebindMask(DI(), d > hn::Zero(DF())), up,
+                        hn::IfThenElse(hn::RebindMask(DI(), d < hn::Zero(DF())), down, zero));
+}
+
+// GridMajorantIterator::FaceAhead along one axis, given that axis' origin,
+// direction, inverse direction, cell, and the grid's cells (its end).
+HWY_INLINE VF FaceAhead(VF o, VF d, VF invD, VI cell, VF cells, VF size) {
+  const VI one = hn::Set(DI(), 1), zero = hn::Zero(DI()), step = StepOf(d);
+  const VI ahead = cell + hn::IfThenElse(step > zero, one, zero);
+  const VF plane = hn::ConvertTo(DF(), ahead) * size;
   // tClip_[a]: where the ray leaves the grid's last cell ahead.
   const VF inf = hn::Set(DF(), std::numeric_limits<float>::infinity());
-  const VF tClip = hn::IfThenElse(w.d[a] > hn::Zero(DF()), (hn::Set(DF(), tables.cells[a]) - w.o[a]) * w.invD[a], inf);
-  const VF t = MinF((plane - w.o[a]) * w.invD[a], tClip);
+  const VF tClip = hn::IfThenElse(d > hn::Zero(DF()), (cells - o) * invD, inf);
+  const VF t = MinF((plane - o) * invD, tClip);
   return hn::IfThenElse(ToF(step == zero), inf, t);
 }
 
 // GridMajorantIterator::EnterLevel in the lanes of `m` (their level and
-// cells set already).
-HWY_INLINE void EnterLevel(const LevelTables& tables, MF m, Walks& w) {
-  const VI node = LevelI(tables.offset, w.level) + w.cell[0] +
-                  LevelI(tables.res[0], w.level) * (w.cell[1] + LevelI(tables.res[1], w.level) * w.cell[2]);
+// cells set already; `at`: that level's numbers).
+HWY_INLINE void EnterLevel(const LevelTables& tables, const LevelNumbers& at, MF m, Walks& w) {
+  const VI node = LevelI(tables.offset, w.level) + w.cell[0] + at.res[0] * (w.cell[1] + at.res[1] * w.cell[2]);
   w.node = SelI(m, node, w.node);
-  for (int a = 0; a < 3; ++a) w.tFace[a] = Sel(m, FaceAhead(tables, w, a), w.tFace[a]);
+  for (int a = 0; a < 3; ++a)
+    w.tFace[a] =
+        Sel(m, FaceAhead(w.o[a], w.d[a], w.invD[a], w.cell[a], hn::Set(DF(), tables.cells[a]), at.size), w.tFace[a]);
 }
 
 // GridMajorantIterator::ExitDistance: where each lane leaves its node, and
@@ -122,168 +127,183 @@ HWY_INLINE VF ExitDistance(const Walks& w, VI* axis) {
   return MaxF(tExit, w.itT);
 }
 
-// GridMajorantIterator::Step in the lanes of `m`; the lanes that moved to
-// a neighbour (the others' walks end: itT = tEnd).
-HWY_INLINE MF Step(const LevelTables& tables, MF m, VI axis, VF tExit, Walks& w) {
+// GridMajorantIterator::Step in the lanes of `m` (`at`: their level's
+// numbers); the lanes that moved to a neighbour (the others' walks end:
+// itT = tEnd). A lane crosses one face: that axis' numbers are picked per
+// lane and its crossing time computed once.
+HWY_INLINE MF Step(const LevelTables& tables, const LevelNumbers& at, MF m, VI axis, VF tExit, Walks& w) {
   w.itT = Sel(m, tExit, w.itT);
-  MF fail = hn::And(m, hn::Or(ToF(axis < hn::Zero(DI())), tExit >= w.tEnd));
+  const MF fail = hn::And(m, hn::Or(ToF(axis < hn::Zero(DI())), tExit >= w.tEnd));
   const MF go = hn::AndNot(fail, m);
-  MF moved = hn::FirstN(DF(), 0);
-  for (int a = 0; a < 3; ++a) {
-    const MF along = hn::And(go, ToF(axis == hn::Set(DI(), a)));
-    if (hn::AllFalse(DF(), along)) continue;
-    const VI step = StepOf(w, a);
-    const VI next = w.cell[a] + step;
-    const MF out = ToF(hn::Or(next < hn::Zero(DI()), hn::Not(next < LevelI(tables.res[a], w.level))));
-    w.cell[a] = SelI(along, next, w.cell[a]);
-    fail = hn::Or(fail, hn::And(along, out));
-    const MF in = hn::AndNot(out, along);
-    w.node = SelI(in, w.node + step * StrideOf(tables, w.level, a), w.node);
-    w.tFace[a] = Sel(in, FaceAhead(tables, w, a), w.tFace[a]);
-    moved = hn::Or(moved, in);
-  }
-  w.itT = Sel(fail, w.tEnd, w.itT);
-  return moved;
+  MF along[3];
+  for (int a = 0; a < 3; ++a) along[a] = hn::And(go, ToF(axis == hn::Set(DI(), a)));
+  auto pickF = [&](const VF* v) { return Sel(along[0], v[0], Sel(along[1], v[1], v[2])); };
+  auto pickI = [&](const VI* v) { return SelI(along[0], v[0], SelI(along[1], v[1], v[2])); };
+  const VF o = pickF(w.o), d = pickF(w.d), invD = pickF(w.invD);
+  const VF cellsPerAxis[3] = {hn::Set(DF(), tables.cells[0]), hn::Set(DF(), tables.cells[1]),
+                              hn::Set(DF(), tables.cells[2])};
+  const VI stride[3] = {hn::Set(DI(), 1), at.res[0], at.res[0] * at.res[1]};
+  const VI step = StepOf(d);
+  const VI next = pickI(w.cell) + step;
+  const MF out = ToF(hn::Or(next < hn::Zero(DI()), hn::Not(next < pickI(at.res))));
+  const MF in = hn::AndNot(out, go);
+  for (int a = 0; a < 3; ++a) w.cell[a] = SelI(along[a], next, w.cell[a]);
+  w.node = SelI(in, w.node + step * pickI(stride), w.node);
+  const VF tFace = FaceAhead(o, d, invD, next, pickF(cellsPerAxis), at.size);
+  for (int a = 0; a < 3; ++a) w.tFace[a] = Sel(hn::And(in, along[a]), tFace, w.tFace[a]);
+  w.itT = Sel(hn::Or(fail, hn::And(go, out)), w.tEnd, w.itT);
+  return in;
 }
 
-// Into the child each lane of `m` is in at itT (GridMajorantIterator::Descend).
-HWY_INLINE void Descend(const LevelTables& tables, int leafLevel, MF m, Walks& w) {
-  const VI child = hn::Min(w.level + hn::Set(DI(), 1), hn::Set(DI(), leafLevel));
-  const VF size = hn::ConvertTo(DF(), LevelI(tables.nodeSize, child));
+// A change of level in the lanes of `m`: up one level in those of `climb`
+// (GridMajorantIterator::Climb, and a step of ClimbToHighestEmptyAncestor),
+// into the child the ray is in at itT in the others
+// (GridMajorantIterator::Descend); then EnterLevel.
+HWY_INLINE void ChangeLevel(const LevelTables& tables, int leafLevel, MF m, MF climb, Walks& w) {
   const VI one = hn::Set(DI(), 1), zero = hn::Zero(DI());
+  const VI child = hn::Min(w.level + one, hn::Set(DI(), leafLevel));
+  const VI level = SelI(climb, w.level - one, child);
+  const LevelNumbers at = NumbersOf(tables, level);
   for (int a = 0; a < 3; ++a) {
     const VF p = w.o[a] + w.d[a] * w.itT;
     const VI twice = w.cell[a] + w.cell[a];
-    const VF mid = hn::ConvertTo(DF(), twice + one) * size;
+    const VF mid = hn::ConvertTo(DF(), twice + one) * at.size;
     const VF rel = p - mid;
-    const MF nearMid = hn::Abs(rel) <= hn::Set(DF(), 1e-4f) * size;  // ties go to the side the ray heads to
+    const MF nearMid = hn::Abs(rel) <= hn::Set(DF(), 1e-4f) * at.size;  // ties go to the side the ray heads to
     const MF upper = hn::Or(hn::And(nearMid, w.d[a] > hn::Zero(DF())), hn::AndNot(nearMid, rel > hn::Zero(DF())));
     const VI cell = twice + hn::IfThenElse(hn::RebindMask(DI(), upper), one, zero);
-    const VI clamped = hn::Min(hn::Max(cell, zero), LevelI(tables.res[a], child) - one);
-    w.cell[a] = SelI(m, clamped, w.cell[a]);
+    const VI descended = hn::Min(hn::Max(cell, zero), at.res[a] - one);
+    w.cell[a] = SelI(m, SelI(climb, hn::ShiftRight<1>(w.cell[a]), descended), w.cell[a]);
   }
-  w.level = SelI(m, child, w.level);
-  EnterLevel(tables, m, w);
+  w.level = SelI(m, level, w.level);
+  EnterLevel(tables, at, m, w);
 }
 
-// One level up in the lanes of `m` (GridMajorantIterator::Climb, and a step
-// of ClimbToHighestEmptyAncestor).
-HWY_INLINE void Climb(const LevelTables& tables, MF m, Walks& w) {
-  w.level = SelI(m, w.level - hn::Set(DI(), 1), w.level);
-  for (int a = 0; a < 3; ++a) w.cell[a] = SelI(m, hn::ShiftRight<1>(w.cell[a]), w.cell[a]);
-  EnterLevel(tables, m, w);
-}
-
-// Loads the walks `id` into lanes.
-HWY_INLINE void LoadWalks(const GridWalkLanes& walks, VI id, Walks& w) {
-  const VI zero = hn::Zero(DI());
+// Starts the walks `id` in the lanes of `m` (the others keep theirs).
+HWY_INLINE void LoadWalks(const GridWalkLanes& walks, MF m, VI id, Walks& w) {
+  auto loadF = [&](const std::vector<float>& v, VF& lane) { lane = Sel(m, GatherF(v.data(), id), lane); };
+  auto loadI = [&](const std::vector<int32_t>& v, VI& lane) { lane = SelI(m, GatherI(v.data(), id), lane); };
   for (int a = 0; a < 3; ++a) {
-    w.o[a] = GatherF(walks.o[a].data(), id);
-    w.d[a] = GatherF(walks.d[a].data(), id);
-    w.invD[a] = GatherF(walks.invD[a].data(), id);
-    w.tFace[a] = GatherF(walks.tFace[a].data(), id);
-    w.cell[a] = GatherI(walks.cell[a].data(), id);
+    loadF(walks.o[a], w.o[a]);
+    loadF(walks.d[a], w.d[a]);
+    loadF(walks.invD[a], w.invD[a]);
+    loadF(walks.tFace[a], w.tFace[a]);
+    loadI(walks.cell[a], w.cell[a]);
   }
-  w.itT = GatherF(walks.itT.data(), id);
-  w.tEnd = GatherF(walks.tEnd.data(), id);
-  w.walkT = GatherF(walks.walkT.data(), id);
-  w.tau = GatherF(walks.tau.data(), id);
-  w.segTMax = GatherF(walks.segTMax.data(), id);
-  w.segMaj = GatherF(walks.segMaj.data(), id);
-  w.level = GatherI(walks.level.data(), id);
-  w.node = GatherI(walks.node.data(), id);
-  w.segments = GatherI(walks.segments.data(), id);
-  w.inSegment = ToF(GatherI(walks.inSegment.data(), id) != zero);
-  w.emptyClimb = ToF(GatherI(walks.emptyClimb.data(), id) != zero);
+  loadF(walks.itT, w.itT);
+  loadF(walks.tEnd, w.tEnd);
+  loadF(walks.tau, w.tau);
+  loadI(walks.level, w.level);
+  loadI(walks.node, w.node);
+  // No segment yet.
+  w.walkT = Sel(m, hn::Zero(DF()), w.walkT);
+  w.segTMax = Sel(m, hn::Zero(DF()), w.segTMax);
+  w.segMaj = Sel(m, hn::Zero(DF()), w.segMaj);
+  w.segments = SelI(m, hn::Zero(DI()), w.segments);
+  w.inSegment = hn::AndNot(m, w.inSegment);
 }
 
-// Stores what a walk changes of the lanes' walks `id`.
-HWY_INLINE void StoreWalks(const Walks& w, VI id, GridWalkLanes& walks) {
-  const DF df;
-  const DI di;
-  const VI one = hn::Set(di, 1), zero = hn::Zero(di);
-  for (int a = 0; a < 3; ++a) {
-    hn::ScatterIndex(w.tFace[a], df, walks.tFace[a].data(), id);
-    hn::ScatterIndex(w.cell[a], di, walks.cell[a].data(), id);
-  }
-  hn::ScatterIndex(w.itT, df, walks.itT.data(), id);
-  hn::ScatterIndex(w.walkT, df, walks.walkT.data(), id);
-  hn::ScatterIndex(w.tau, df, walks.tau.data(), id);
-  hn::ScatterIndex(w.segTMax, df, walks.segTMax.data(), id);
-  hn::ScatterIndex(w.segMaj, df, walks.segMaj.data(), id);
-  hn::ScatterIndex(w.level, di, walks.level.data(), id);
-  hn::ScatterIndex(w.node, di, walks.node.data(), id);
-  hn::ScatterIndex(w.segments, di, walks.segments.data(), id);
-  hn::ScatterIndex(SelI(w.inSegment, one, zero), di, walks.inSegment.data(), id);
-  hn::ScatterIndex(SelI(w.emptyClimb, one, zero), di, walks.emptyClimb.data(), id);
+// SampleTentativeCollisions' inner loop, once, in the lanes of `m` (in a
+// segment): the next arrival in the segment, or the segment used up (its
+// optical depth carried on). Returns the lanes at an arrival.
+HWY_INLINE MF InSegment(MF m, Walks& w) {
+  const VF tauLeft = (w.segTMax - w.walkT) * w.segMaj;
+  const MF usedUp = hn::And(m, w.tau >= tauLeft);
+  const MF arrive = hn::AndNot(usedUp, m);
+  w.tau = Sel(usedUp, w.tau - tauLeft, w.tau);
+  w.walkT = Sel(arrive, w.walkT + w.tau / w.segMaj, w.walkT);
+  w.inSegment = hn::AndNot(usedUp, w.inSegment);
+  return arrive;
 }
 
-// One action of every lane in `live`: an arrival in its segment or the
-// segment used up, then, between segments, the grid walk's next action
-// (GridMajorantIterator::Next: a climb, a descent, a step out of an empty
-// node, or a segment handed out) or its end. Returns the lanes whose walk
-// ended; `arrived`: the lanes at an arrival.
+// GridMajorantIterator::ClimbToHighestEmptyAncestor in the lanes of `m`,
+// whose parent the caller found empty: up while the next parent is empty
+// too, then EnterLevel once.
+HWY_INLINE void ClimbEmpty(const MajorantGridView& grid, const LevelTables& tables, MF m, Walks& w) {
+  const VI one = hn::Set(DI(), 1), zero = hn::Zero(DI());
+  MF up = m;
+  while (!hn::AllFalse(DF(), up)) {
+    w.level = SelI(up, w.level - one, w.level);
+    for (int a = 0; a < 3; ++a) w.cell[a] = SelI(up, hn::ShiftRight<1>(w.cell[a]), w.cell[a]);
+    const MF climbing = hn::And(up, ToF(w.level > zero));
+    if (hn::AllFalse(DF(), climbing)) break;
+    const VI parentLevel = hn::Max(w.level - one, zero);
+    const VI parentNode =
+        LevelI(tables.offset, parentLevel) + hn::ShiftRight<1>(w.cell[0]) +
+        LevelI(tables.res[0], parentLevel) *
+            (hn::ShiftRight<1>(w.cell[1]) + LevelI(tables.res[1], parentLevel) * hn::ShiftRight<1>(w.cell[2]));
+    up = hn::AndNot(GatherF(grid.majorants, SelI(climbing, parentNode, zero)) > hn::Zero(DF()), climbing);
+  }
+  EnterLevel(tables, NumbersOf(tables, w.level), m, w);
+}
+
+// One action of every lane in `live`: an arrival in its segment, or, with
+// the segment used up or between segments, the grid walk's next segment as
+// GridMajorantIterator::Next finds it (its climbs and descents, then one
+// step: out of an empty node, or past the segment handed out) and the
+// first arrival in that segment; or the walk's end. A lane whose empty step
+// or segment leaves it without an arrival goes on in the next action.
+// Returns the lanes whose walk ended; `arrived`: the lanes at an arrival.
 HWY_INLINE MF Act(const MajorantGridView& grid, const LevelTables& tables, bool octree, VF scale, MF live, Walks& w,
                   MF* arrived) {
   const DF df;
   const DI di;
   const VF zeroF = hn::Zero(df);
   const VI zeroI = hn::Zero(di), oneI = hn::Set(di, 1);
-  // In a segment (SampleTentativeCollisions' inner loop).
-  const MF inSegment = hn::And(live, w.inSegment);
-  const VF tauLeft = (w.segTMax - w.walkT) * w.segMaj;
-  const MF usedUp = hn::And(inSegment, w.tau >= tauLeft);
-  const MF arrive = hn::AndNot(usedUp, inSegment);
-  w.tau = Sel(usedUp, w.tau - tauLeft, w.tau);
-  w.walkT = Sel(arrive, w.walkT + w.tau / w.segMaj, w.walkT);
-  w.inSegment = hn::AndNot(usedUp, w.inSegment);
-  *arrived = arrive;
+  *arrived = InSegment(hn::And(live, w.inSegment), w);
 
-  // Between segments.
+  // Between segments: Next's loop, a decision a round; the lanes that
+  // climb or descend decide again at their new level.
   const MF walking = hn::AndNot(w.inSegment, live);
   const MF going = hn::And(walking, w.itT < w.tEnd);
   const MF finished = hn::AndNot(going, walking);
   if (hn::AllFalse(df, going)) return finished;
-  const VF maj = GatherF(grid.majorants, SelI(going, w.node, zeroI));
-  const MF empty = hn::And(going, hn::Or(w.emptyClimb, maj <= zeroF));
-  MF climbEmpty = hn::FirstN(df, 0), climb = climbEmpty, descend = climbEmpty;
-  const MF nonEmpty = hn::AndNot(empty, going);
-  if (octree) {
-    const VI parentLevel = hn::Max(w.level - oneI, zeroI);
-    const VI parentNode =
-        LevelI(tables.offset, parentLevel) + hn::ShiftRight<1>(w.cell[0]) +
-        LevelI(tables.res[0], parentLevel) *
-            (hn::ShiftRight<1>(w.cell[1]) + LevelI(tables.res[1], parentLevel) * hn::ShiftRight<1>(w.cell[2]));
-    const MF hasParent = hn::And(going, ToF(w.level > zeroI));
-    const VF parentMaj = GatherF(grid.majorants, SelI(hasParent, parentNode, zeroI));
-    // ClimbToHighestEmptyAncestor, a level an action.
-    climbEmpty = hn::AndNot(parentMaj > zeroF, hn::And(empty, hasParent));
-    const VF tau = maj * scale * LevelF(tables.worldWidth, w.level);
-    const MF thin = hn::And(tau < hn::Set(df, kClimbOpticalThickness), hasParent);
-    const VF parentTau = parentMaj * scale * LevelF(tables.worldWidth, parentLevel);
-    climb = hn::And(hn::And(nonEmpty, thin), parentTau <= hn::Set(df, kDescendOpticalThickness));
-    descend = hn::And(hn::AndNot(thin, nonEmpty),
-                      hn::And(tau > hn::Set(df, kDescendOpticalThickness), ToF(w.level < hn::Set(di, grid.leafLevel))));
+  VF maj = zeroF;
+  MF deciding = going, empty = hn::FirstN(df, 0), emit = empty;
+  for (;;) {
+    maj = Sel(deciding, GatherF(grid.majorants, SelI(deciding, w.node, zeroI)), maj);
+    const MF emptyHere = hn::And(deciding, maj <= zeroF);
+    const MF nonEmpty = hn::AndNot(emptyHere, deciding);
+    MF climb = hn::FirstN(df, 0), descend = climb;
+    if (octree) {
+      const VI parentLevel = hn::Max(w.level - oneI, zeroI);
+      const VI parentNode =
+          LevelI(tables.offset, parentLevel) + hn::ShiftRight<1>(w.cell[0]) +
+          LevelI(tables.res[0], parentLevel) *
+              (hn::ShiftRight<1>(w.cell[1]) + LevelI(tables.res[1], parentLevel) * hn::ShiftRight<1>(w.cell[2]));
+      const MF hasParent = hn::And(deciding, ToF(w.level > zeroI));
+      const VF parentMaj = GatherF(grid.majorants, SelI(hasParent, parentNode, zeroI));
+      const VF tau = maj * scale * LevelF(tables.worldWidth, w.level);
+      const MF thin = hn::And(tau < hn::Set(df, kClimbOpticalThickness), hasParent);
+      const VF parentTau = parentMaj * scale * LevelF(tables.worldWidth, parentLevel);
+      climb = hn::And(hn::And(nonEmpty, thin), parentTau <= hn::Set(df, kDescendOpticalThickness));
+      descend = hn::And(hn::AndNot(thin, nonEmpty), hn::And(tau > hn::Set(df, kDescendOpticalThickness),
+                                                            ToF(w.level < hn::Set(di, grid.leafLevel))));
+      const MF climbEmpty = hn::AndNot(parentMaj > zeroF, hn::And(emptyHere, hasParent));
+      if (!hn::AllFalse(df, climbEmpty)) ClimbEmpty(grid, tables, climbEmpty, w);
+    }
+    empty = hn::Or(empty, emptyHere);
+    deciding = hn::Or(climb, descend);
+    emit = hn::Or(emit, hn::AndNot(deciding, nonEmpty));
+    if (hn::AllFalse(df, deciding)) break;
+    ChangeLevel(tables, grid.leafLevel, deciding, climb, w);
   }
-  const MF stepEmpty = hn::AndNot(climbEmpty, empty);
-  const MF emit = hn::AndNot(hn::Or(climb, descend), nonEmpty);
-  const MF climbing = hn::Or(climb, climbEmpty);
-  if (!hn::AllFalse(df, climbing)) Climb(tables, climbing, w);
-  if (!hn::AllFalse(df, descend)) Descend(tables, grid.leafLevel, descend, w);
-  w.emptyClimb = hn::Or(hn::AndNot(stepEmpty, w.emptyClimb), climbEmpty);
-  const MF stepping = hn::Or(stepEmpty, emit);
-  if (hn::AllFalse(df, stepping)) return finished;
+
+  // The step, at the level each lane stays on.
+  const MF stepping = hn::Or(empty, emit);
   VI axis;
   const VF tExit = ExitDistance(w, &axis);
   const VF segTMin = w.itT, segMaj = maj * scale;
-  const MF moved = Step(tables, stepping, axis, tExit, w);
-  // A segment handed out, taken by the loop over segments.
+  const MF moved = Step(tables, NumbersOf(tables, w.level), stepping, axis, tExit, w);
+  // A segment handed out, taken by the loop over segments, and its first
+  // arrival.
   w.segments = SelI(emit, w.segments + oneI, w.segments);
   w.segMaj = Sel(emit, segMaj, w.segMaj);
   w.segTMax = Sel(emit, Sel(moved, tExit, w.tEnd), w.segTMax);
   const MF taken = hn::AndNot(segMaj <= zeroF, emit);
   w.walkT = Sel(taken, segTMin, w.walkT);
   w.inSegment = hn::Or(w.inSegment, taken);
+  *arrived = hn::Or(*arrived, InSegment(taken, w));
   return finished;
 }
 
@@ -322,21 +342,21 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
   for (size_t k = 0; k < n; ++k) laneId[k] = scratch;
   VI id = hn::Load(di, laneId);
   Walks w;
-  LoadWalks(walks, id, w);
+  w.inSegment = hn::FirstN(df, 0);
+  LoadWalks(walks, hn::Not(w.inSegment), id, w);
   MF live = hn::FirstN(df, 0), free = hn::Not(live);
   size_t next = 0;
   LaneCounters c;
   for (;;) {
-    // Refill when half the lanes are free: every lane's walk stored, the
-    // free lanes given the next walks, all loaded again.
+    // Refill when half the lanes are free: the free lanes given the next
+    // walks. A walk's state stays in its lane until it ends; of an ended
+    // walk only its segment count is stored.
     if (next < count && hn::CountTrue(df, free) * 2 >= n) {
-      StoreWalks(w, id, walks);
-      hn::Store(id, di, laneId);
       hn::Store(SelI(free, oneI, zeroI), di, flag);
       for (size_t k = 0; k < n; ++k)
         if (flag[k]) laneId[k] = next < count ? (int32_t)ids[next++] : scratch;
       id = hn::Load(di, laneId);
-      LoadWalks(walks, id, w);
+      LoadWalks(walks, free, SelI(free, id, scratchI), w);
       live = hn::Or(live, hn::And(free, ToF(hn::Not(id == scratchI))));
       free = hn::Not(live);
       ++c.refills;
@@ -360,9 +380,13 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       hn::Store(w.segMaj, df, laneMaj);
       hn::Store(w.tau, df, laneTau);
       hn::Store(id, di, laneId);
-      hn::Store(SelI(arrived, oneI, zeroI), di, flag);
-      for (size_t k = 0; k < n; ++k) {
-        if (!flag[k]) continue;
+      uint8_t arrivedBits[8] = {};
+      hn::StoreMaskBits(df, arrived, arrivedBits);
+      uint64_t pending;
+      std::memcpy(&pending, arrivedBits, sizeof pending);
+      hn::Store(zeroI, di, flag);
+      for (; pending; pending &= pending - 1) {
+        const int k = __builtin_ctzll(pending);
         flag[k] = choices.Real((uint32_t)laneId[k], laneT[k], Vec3{px[k], py[k], pz[k]}, laneMaj[k],
                                Plain ? &laneSigma[k] : nullptr, &laneTau[k])
                       ? 1
@@ -372,10 +396,10 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       w.tau = Sel(hn::AndNot(real, arrived), hn::Load(df, laneTau), w.tau);
     }
     const MF done = hn::Or(ended, real);
+    if (!hn::AllFalse(df, done)) hn::ScatterIndex(w.segments, di, walks.segments.data(), SelI(done, id, scratchI));
     live = hn::AndNot(done, live);
     free = hn::Or(free, done);
   }
-  StoreWalks(w, id, walks);  // the segments counted
   c.lanes = n;
   if (counters) *counters += c;
 }
@@ -410,11 +434,15 @@ namespace mmrtm {
 HWY_EXPORT(DeltaTrackWalksLanes);
 
 void GridWalkLanes::Resize(size_t n) {
-  for (int a = 0; a < 3; ++a)
-    for (auto* v : {&o[a], &d[a], &invD[a], &tFace[a]}) v->assign(n + 1, 0.f);
-  for (int a = 0; a < 3; ++a) cell[a].assign(n + 1, 0);
-  for (auto* v : {&itT, &tEnd, &walkT, &tau, &segTMax, &segMaj}) v->assign(n + 1, 0.f);
-  for (auto* v : {&level, &node, &inSegment, &emptyClimb, &segments}) v->assign(n + 1, 0);
+  if (itT.size() < n + 1) {
+    for (int a = 0; a < 3; ++a)
+      for (auto* v : {&o[a], &d[a], &invD[a], &tFace[a]}) v->resize(n + 1);
+    for (int a = 0; a < 3; ++a) cell[a].resize(n + 1);
+    for (auto* v : {&itT, &tEnd, &tau}) v->resize(n + 1);
+    for (auto* v : {&level, &node, &segments}) v->resize(n + 1);
+  }
+  // The scratch slot (the last): an ended walk at level 0.
+  Set(itT.size() - 1, GridWalkState{}, 0.f);
 }
 
 void GridWalkLanes::Set(size_t i, const GridWalkState& s, float walkTau) {
@@ -427,12 +455,10 @@ void GridWalkLanes::Set(size_t i, const GridWalkState& s, float walkTau) {
   }
   itT[i] = s.t;
   tEnd[i] = s.tEnd;
+  tau[i] = walkTau;
   level[i] = s.level;
   node[i] = (int32_t)s.node;
-  walkT[i] = 0.f;
-  tau[i] = walkTau;
-  segTMax[i] = segMaj[i] = 0.f;
-  inSegment[i] = emptyClimb[i] = segments[i] = 0;
+  segments[i] = 0;
 }
 
 bool GridWalkLanesFit(const MajorantGridView& grid) {

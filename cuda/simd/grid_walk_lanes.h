@@ -4,11 +4,11 @@
 // SampleTentativeCollisions: the optical depth used up segment by
 // segment), the extinction there (a plain scene's, in lanes), and the
 // caller's real-or-null choice, with masks for the lanes that arrive,
-// collide or end early. Every operation is the scalar walk's, in its order, so a walk
-// gives the same segments and arrivals to the last bit
+// collide or end early. Every operation is the scalar walk's, in its
+// order, so a walk gives the same segments and arrivals to the last bit
 // (Testing/Cxx/TestSimdBackend: any drift between the two fails there on
-// every scene). The climb to the highest empty ancestor takes one level an
-// action, and arrives at the same node.
+// every scene). A lane's action is an arrival, or Next's climbs and
+// descents up to its step out of a node and the first arrival after it.
 #pragma once
 
 #include <cstddef>
@@ -21,20 +21,22 @@
 
 namespace mmrtm {
 
-// The walks' state in structure-of-arrays form: slot i is walk i; the
-// slot after the last is scratch, where padded lanes read and write.
+// The walks in structure-of-arrays form, slot i walk i: where each starts
+// (the lanes take it from here and keep the rest of the walk in
+// registers) and, once it ended, how many majorant segments it was handed.
+// The last slot is scratch, where padded lanes read and write.
 struct GridWalkLanes {
   std::vector<float> o[3], d[3], invD[3], tFace[3];
-  std::vector<float> itT, tEnd;                    // the grid walk's distance and end
-  std::vector<float> walkT, tau, segTMax, segMaj;  // SampleTentativeCollisions' (the arrival's t, ...)
+  std::vector<float> itT, tEnd;  // the grid walk's distance and end
+  std::vector<float> tau;        // the optical depth to the first arrival
   std::vector<int32_t> cell[3], level, node;
-  std::vector<int32_t> inSegment, emptyClimb;  // 0 or 1 (-1 in lanes)
-  std::vector<int32_t> segments;               // majorant segments handed out, a count per walk
+  std::vector<int32_t> segments;  // the result
 
-  // Room for n walks (and the scratch slot, an ended walk).
+  // Room for at least n walks, and the scratch slot after them (an ended
+  // walk): the slots a caller does not Set keep what they held.
   void Resize(size_t n);
   // Walk i from a scalar walk's state (`tau`: its optical depth to the first
-  // arrival); no segment yet.
+  // arrival).
   void Set(size_t i, const GridWalkState& s, float tau);
 };
 
