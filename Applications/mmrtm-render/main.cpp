@@ -530,7 +530,7 @@ int Run(const Options& o) {
   mmrtm::TraceCounters counters;
   if (!o.quiet)
     std::fprintf(stderr, "%d x %d, %d spp, %s, %s, majorant %.4g /mm\n", rs.width, rs.height, rs.samplesPerPixel,
-                 renderer->Description().c_str(),
+                 renderer->Description(view).c_str(),
                  rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
                  view.majorants.globalMajorant);
   ProgressBar bar(!o.quiet);
@@ -575,7 +575,7 @@ int Run(const Options& o) {
         {"noise_target", o.noiseTarget > 0 ? json(o.noiseTarget) : json(nullptr)},
         {"stopped_on", reachedTarget ? "noise_target" : "spp"},
         {"threads", rs.threads > 0 ? rs.threads : (int)std::thread::hardware_concurrency()},
-        {"backend", renderer->Description()},
+        {"backend", renderer->Description(view)},
         {"seed", rs.integrator.seed},
         {"estimator", rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "raymarch" : "delta"},
         {"shadow_extinction_scale", rs.integrator.shadowExtinctionScale},

@@ -64,23 +64,25 @@ void Record(const mmrtm::FreePathResult& fp, size_t i, FreePaths* out) {
 [[gnu::noinline]] void RunLanes(const mmrtm::SceneView& s, int spp, FreePaths* out, mmrtm::TraceCounters* ctr,
                                 mmrtm::LaneCounters* lanes) {
   mmrtm::WavefrontCameraPaths tracker;
+  std::vector<mmrtm::PixelSampleId> samples;
   std::vector<mmrtm::CameraPath> paths;
+  samples.reserve(1024);
   paths.reserve(1024);
   size_t first = 0;
   auto finish = [&] {
-    tracker.Track(s, paths, lanes);
+    tracker.Track(s, samples, paths, lanes);
     for (size_t k = 0; k < paths.size(); ++k) {
       Record(paths[k].freePath, first + k, out);
       *ctr += paths[k].ctr;
     }
     first += paths.size();
-    paths.clear();
+    samples.clear();
   };
   for (int y = 0; y < s.camera.height; ++y)
     for (int x = 0; x < s.camera.width; ++x)
       for (int index = 0; index < spp; ++index) {
-        if (paths.size() == 1024) finish();
-        paths.emplace_back(s, x, y, (uint32_t)index);
+        if (samples.size() == 1024) finish();
+        samples.push_back({x, y, (uint32_t)index});
       }
   finish();
 }

@@ -1302,6 +1302,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   Internals& in = *this->Internal;
   const auto buildStart = std::chrono::steady_clock::now();
   const mmrtm::SceneView sceneView = this->BuildScene();
+  if (in.Renderer)
+    in.BackendDescription = in.Renderer->Description(sceneView);
   in.CountGridWork();
   if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning) // once per change, not per render
   {

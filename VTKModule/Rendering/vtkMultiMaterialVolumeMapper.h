@@ -542,7 +542,8 @@ public:
   static double GetLabelDensityAtFullOpacity();
 
   /**
-   * Description of the backend in use ("cpu, 2 thread(s)"), after a render.
+   * Description of the backend in use ("cpu, 2 thread(s), SIMD AVX3", "cpu, 2
+   * thread(s), scalar", "cuda, ..."): after a render, what rendered its scene.
    */
   const char* GetBackendDescription();
 

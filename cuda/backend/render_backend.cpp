@@ -17,6 +17,7 @@ class CpuBackend : public Renderer {
  public:
   CpuBackend(int threads, SimdMode simd) : cpu_(threads, simd) {}
   std::string Description() const override { return cpu_.Description(); }
+  std::string Description(const SceneView& view) const override { return cpu_.Description(&view); }
   bool IsCuda() const override { return false; }
   bool Render(const Scene&, const SceneView& view, Film& film, int spp, TraceCounters* counters,
               const Progress& progress, const std::atomic<bool>* cancel) override {

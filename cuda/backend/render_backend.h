@@ -40,8 +40,14 @@ void RequireBackend(Backend backend);
 class Renderer {
  public:
   virtual ~Renderer() = default;
-  // "cpu, 2 threads", "cuda, NVIDIA H100 ...": for progress lines and stats.
+  // "cpu, 2 thread(s), SIMD AVX3", "cuda, NVIDIA H100 ...": for progress
+  // lines and stats; the second says what renders `view` (the CPU's SIMD
+  // lanes run some scenes only).
   virtual std::string Description() const = 0;
+  virtual std::string Description(const SceneView& view) const {
+    (void)view;
+    return Description();
+  }
   virtual bool IsCuda() const = 0;
   // Adds `samplesPerPixel` samples of `view` (built by `scene`, whose grid
   // the CUDA backend refits on the device) to `film`. Returns false when

@@ -36,13 +36,17 @@ CpuRenderer::CpuRenderer(int threads, SimdMode simd)
 }
 
 bool CpuRenderer::UsesSimd(const SceneView& scene) const {
-  return simd_ == SimdMode::On && scene.settings.projection.mode == IntensityProjection::None &&
-         WavefrontCameraPaths::Runs(scene);
+  if (simd_ == SimdMode::Off || scene.settings.projection.mode != IntensityProjection::None) return false;
+  return simd_ == SimdMode::On ? WavefrontCameraPaths::Runs(scene) : WavefrontCameraPaths::Faster(scene);
 }
 
-std::string CpuRenderer::Description() const {
-  std::string d = "cpu, " + std::to_string(threads_) + " thread(s), ";
-  return d + (simd_ == SimdMode::On && SimdLookupsBuilt() ? std::string("SIMD ") + SimdLookupTarget() : "scalar");
+std::string CpuRenderer::Description(const SceneView* scene) const {
+  const std::string d = "cpu, " + std::to_string(threads_) + " thread(s), ";
+  const std::string lanes = std::string("SIMD ") + SimdLookupTarget();
+  if (scene) return d + (UsesSimd(*scene) ? lanes : "scalar");
+  if (!SimdLookupsBuilt() || simd_ == SimdMode::Off) return d + "scalar";
+  if (simd_ == SimdMode::On) return d + lanes;
+  return d + (SimdLookupLanes() >= WavefrontCameraPaths::kFasterLanes ? lanes + " where faster" : "scalar");
 }
 
 bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,

@@ -21,11 +21,10 @@ namespace mmrtm {
 // Highway, delta tracking over a majorant grid, no intensity projection:
 // WavefrontCameraPaths::Runs): a tile's camera rays delta-tracked in SIMD
 // lanes (wavefront_camera_paths.h). Off: the scalar backend. Both give the
-// same image to the last bit. Auto: the faster of the two for the scene,
-// which is the scalar backend on every scene measured so far (the lanes
-// took 0.96-1.04 times its time: Documentation/performance.md, "SIMD
-// lanes: the camera stage"), so that no user pays for lanes that do not
-// pay yet.
+// same image to the last bit. Auto: the faster of the two for the scene
+// on this CPU (WavefrontCameraPaths::Faster: the SIMD backend where the
+// lanes start the camera paths too and have 8 or more floats, AVX2 and
+// AVX-512; Documentation/performance.md, "SIMD lanes: the camera stage").
 enum class SimdMode { Off, Auto, On };
 std::optional<SimdMode> ParseSimdMode(const std::string& name);
 
@@ -37,8 +36,9 @@ class CpuRenderer {
   int Threads() const { return threads_; }
   // Whether a render of `scene` runs the SIMD backend.
   bool UsesSimd(const SceneView& scene) const;
-  // "cpu, 2 thread(s), SIMD AVX3" (or "scalar").
-  std::string Description() const;
+  // "cpu, 2 thread(s), SIMD AVX3" (or "scalar"): what renders `scene`; without
+  // one, what this mode runs where it can ("SIMD AVX3 where faster" for auto).
+  std::string Description(const SceneView* scene = nullptr) const;
   // Where the renders that follow add their lanes' occupancy (null: not counted).
   void CountLanes(LaneCounters* lanes) { lanes_ = lanes; }
 

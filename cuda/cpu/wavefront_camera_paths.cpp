@@ -1,6 +1,7 @@
 #include "wavefront_camera_paths.h"
 
 #ifdef MMRTM_HAVE_SIMD
+#include "camera_path_starts.h"
 #include "grid_walk_lanes.h"
 #include "plain_extinction.h"
 #endif
@@ -9,9 +10,11 @@ namespace mmrtm {
 
 #ifndef MMRTM_HAVE_SIMD
 struct GridWalkLanes {};
+struct CameraPathStarts {};
 #endif
 
-WavefrontCameraPaths::WavefrontCameraPaths() : walks_(std::make_unique<GridWalkLanes>()) {}
+WavefrontCameraPaths::WavefrontCameraPaths()
+    : walks_(std::make_unique<GridWalkLanes>()), starts_(std::make_unique<CameraPathStarts>()) {}
 WavefrontCameraPaths::~WavefrontCameraPaths() = default;
 
 bool SimdLookupsBuilt() {
@@ -27,6 +30,14 @@ const char* SimdLookupTarget() {
   return PlainExtinctionTarget();
 #else
   return "";
+#endif
+}
+
+int SimdLookupLanes() {
+#ifdef MMRTM_HAVE_SIMD
+  return PlainExtinctionLaneCount();
+#else
+  return 0;
 #endif
 }
 
@@ -75,21 +86,58 @@ bool WavefrontCameraPaths::Runs(const SceneView& s) {
 #endif
 }
 
-void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& paths, LaneCounters* lanes) {
+bool WavefrontCameraPaths::Faster(const SceneView& s) {
+#ifdef MMRTM_HAVE_SIMD
+  return Runs(s) && CameraPathStartsRun(s) && SimdLookupLanes() >= kFasterLanes;
+#else
+  (void)s;
+  return false;
+#endif
+}
+
+void WavefrontCameraPaths::Track(const SceneView& s, const std::vector<PixelSampleId>& samples,
+                                 std::vector<CameraPath>& paths, LaneCounters* lanes) {
 #ifdef MMRTM_HAVE_SIMD
   MMRTM_DCHECK(Runs(s));
-  walks_->Resize(paths.size());
+  const size_t count = samples.size();
+  paths.clear();
+  walks_->Resize(count);
   walking_.clear();
-  for (uint32_t i = 0; i < (uint32_t)paths.size(); ++i) {
-    CameraPath& path = paths[i];
-    path.freePath = FreePathResult();
-    if (!path.walk.inDomain) continue;
-    float u0, u1;
-    path.sample.FreePathPair(&u0, &u1);
-    path.walk.DrawFirstArrival(path.sample.rng, u0);
-    path.choice = DeltaTrackingChoice{u1};
-    walks_->Set(i, path.walk.it.GridWalk()->State(), path.walk.tau);
-    walking_.push_back(i);
+  if (CameraPathStartsRun(s)) {
+    CameraPathStarts& st = *starts_;
+    st.Resize(count);
+    for (size_t i = 0; i < count; ++i) {
+      st.x[i] = samples[i].x;
+      st.y[i] = samples[i].y;
+      st.sampleIndex[i] = samples[i].index;
+    }
+    StartCameraPaths(s, st);
+    const float* const indexO[3] = {st.indexO[0].data(), st.indexO[1].data(), st.indexO[2].data()};
+    const float* const indexD[3] = {st.indexD[0].data(), st.indexD[1].data(), st.indexD[2].data()};
+    StartWalks(s.majorants.grid, indexO, indexD, st.t0.data(), st.t1.data(), count, *walks_);
+    for (uint32_t i = 0; i < (uint32_t)count; ++i) {
+      const Ray ray{{st.o[0][i], st.o[1][i], st.o[2][i]}, {st.d[0][i], st.d[1][i], st.d[2][i]}};
+      CameraPath& path = paths.emplace_back(CameraSample(PCG32::FromState(st.rngState[i], st.rngInc[i]),
+                                                         SobolPairs::FromKey(st.sobolKey[i], st.sobolReversedIndex[i]),
+                                                         true, ray, st.tMax[i]));
+      if (!st.inDomain[i]) continue;
+      // DrawFirstArrival with the Sobol' number.
+      walks_->tau[i] = TentativeCollisionStart::OpticalDepthToArrival(st.freePathU0[i]);
+      path.choice = DeltaTrackingChoice{st.freePathU1[i]};
+      walking_.push_back(i);
+    }
+  } else {
+    for (uint32_t i = 0; i < (uint32_t)count; ++i) {
+      CameraPath& path = paths.emplace_back(CameraSample(s, samples[i].x, samples[i].y, samples[i].index));
+      TentativeCollisionStart walk(s, path.sample.ray, path.sample.tMax, 1.f);
+      if (!walk.inDomain) continue;
+      float u0, u1;
+      path.sample.FreePathPair(&u0, &u1);
+      walk.DrawFirstArrival(path.sample.rng, u0);
+      path.choice = DeltaTrackingChoice{u1};
+      walks_->Set(i, walk.it.GridWalk()->State(), walk.tau);
+      walking_.push_back(i);
+    }
   }
   CameraChoices choices(s, paths);
   const GridTraversal traversal =
@@ -98,6 +146,7 @@ void WavefrontCameraPaths::Track(const SceneView& s, std::vector<CameraPath>& pa
   for (uint32_t i : walking_) paths[i].ctr.majorantSegments += (uint64_t)walks_->segments[i];
 #else
   (void)s;
+  (void)samples;
   (void)paths;
   (void)lanes;
 #endif

@@ -31,13 +31,9 @@ class WavefrontTile {
  private:
   void Finish(const SceneView& s, const FilmView& view, TraceCounters& ctr, LaneCounters* lanes);
 
-  struct Origin {
-    int x, y;
-    uint32_t index;   // the sample index
-    uint32_t inTile;  // the pixel's index in the tile
-  };
+  std::vector<PixelSampleId> samples_;
+  std::vector<uint32_t> inTile_;  // each sample's pixel's index in the tile
   std::vector<CameraPath> paths_;
-  std::vector<Origin> origins_;
   std::vector<uint64_t> work_;  // each pixel of the tile
   WavefrontCameraPaths tracker_;
 };

@@ -98,7 +98,7 @@ HWY_INLINE VF FaceAhead(VF o, VF d, VF invD, VI cell, VF cells, VF size) {
   const VI ahead = cell + hn::IfThenElse(step > zero, one, zero);
   const VF plane = hn::ConvertTo(DF(), ahead) * size;
   // tClip_[a]: where the ray leaves the grid's last cell ahead.
-  const VF inf = hn::Set(DF(), std::numeric_limits<float>::infinity());
+  const VF inf = hn::Set(DF(), kInfinity);
   const VF tClip = hn::IfThenElse(d > hn::Zero(DF()), (cells - o) * invD, inf);
   const VF t = MinF((plane - o) * invD, tClip);
   return hn::IfThenElse(ToF(step == zero), inf, t);
@@ -404,6 +404,52 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
   if (counters) *counters += c;
 }
 
+// GridMajorantIterator's constructor for walks [0, count) (contiguous, in
+// whole vectors: the walks' arrays are padded), from index rays (o, d)
+// over [t0, t1): at the leaf each ray starts in.
+void StartWalksLanes(const MajorantGridView& grid, const float* const* o, const float* const* d, const float* t0,
+                     const float* t1, size_t count, GridWalkLanes& walks) {
+  const DF df;
+  const DI di;
+  const size_t n = hn::Lanes(df);
+  const int leaf = grid.leafLevel;
+  const VF zeroF = hn::Zero(df), oneF = hn::Set(df, 1.f);
+  const VF size = hn::Set(df, (float)grid.nodeSize[leaf]);
+  for (size_t i = 0; i < count; i += n) {
+    Walks w;
+    for (int a = 0; a < 3; ++a) {
+      w.o[a] = hn::LoadU(df, o[a] + i);
+      w.d[a] = hn::LoadU(df, d[a] + i);
+      w.invD[a] = hn::IfThenElse(w.d[a] != zeroF, oneF / w.d[a], zeroF);
+    }
+    w.itT = hn::LoadU(df, t0 + i);
+    w.tEnd = hn::LoadU(df, t1 + i);
+    w.level = hn::Set(di, leaf);
+    for (int a = 0; a < 3; ++a) {
+      const VF x = (w.o[a] + w.d[a] * w.itT) / size;  // FloorClamped(x, res - 1)
+      const VI hi = hn::Set(di, grid.res[leaf][a] - 1);
+      const VI inside = hn::IfThenElse(hn::RebindMask(di, x < hn::ConvertTo(df, hi)), hn::ConvertTo(di, x), hi);
+      w.cell[a] = hn::IfThenElse(hn::RebindMask(di, x >= oneF), inside, hn::Zero(di));
+    }
+    // EnterLevel.
+    const VI node = hn::Set(di, (int32_t)grid.offset[leaf]) + w.cell[0] +
+                    hn::Set(di, grid.res[leaf][0]) * (w.cell[1] + hn::Set(di, grid.res[leaf][1]) * w.cell[2]);
+    for (int a = 0; a < 3; ++a) {
+      const VF tFace = FaceAhead(w.o[a], w.d[a], w.invD[a], w.cell[a], hn::Set(df, (float)grid.cells[a]), size);
+      hn::StoreU(w.o[a], df, walks.o[a].data() + i);
+      hn::StoreU(w.d[a], df, walks.d[a].data() + i);
+      hn::StoreU(w.invD[a], df, walks.invD[a].data() + i);
+      hn::StoreU(tFace, df, walks.tFace[a].data() + i);
+      hn::StoreU(w.cell[a], di, walks.cell[a].data() + i);
+    }
+    hn::StoreU(w.itT, df, walks.itT.data() + i);
+    hn::StoreU(w.tEnd, df, walks.tEnd.data() + i);
+    hn::StoreU(w.level, di, walks.level.data() + i);
+    hn::StoreU(node, di, walks.node.data() + i);
+    hn::StoreU(hn::Zero(di), di, walks.segments.data() + i);
+  }
+}
+
 void DeltaTrackWalksLanes(const Classifier& classifier, const MajorantGridView& grid, GridTraversal traversal,
                           GridWalkLanes& walks, const uint32_t* ids, size_t count, ArrivalChoices& choices,
                           LaneCounters* counters) {
@@ -432,14 +478,22 @@ HWY_AFTER_NAMESPACE();
 namespace mmrtm {
 
 HWY_EXPORT(DeltaTrackWalksLanes);
+HWY_EXPORT(StartWalksLanes);
+
+namespace {
+// Whole vectors past the last walk (StartWalks): the widest vector of any
+// target (SVE's 2048 bits; HWY_MAX_BYTES here is the last target's).
+constexpr size_t kPad = 256 / sizeof(float);
+}  // namespace
 
 void GridWalkLanes::Resize(size_t n) {
-  if (itT.size() < n + 1) {
+  const size_t slots = n + kPad + 1;
+  if (itT.size() < slots) {
     for (int a = 0; a < 3; ++a)
-      for (auto* v : {&o[a], &d[a], &invD[a], &tFace[a]}) v->resize(n + 1);
-    for (int a = 0; a < 3; ++a) cell[a].resize(n + 1);
-    for (auto* v : {&itT, &tEnd, &tau}) v->resize(n + 1);
-    for (auto* v : {&level, &node, &segments}) v->resize(n + 1);
+      for (auto* v : {&o[a], &d[a], &invD[a], &tFace[a]}) v->resize(slots);
+    for (int a = 0; a < 3; ++a) cell[a].resize(slots);
+    for (auto* v : {&itT, &tEnd, &tau}) v->resize(slots);
+    for (auto* v : {&level, &node, &segments}) v->resize(slots);
   }
   // The scratch slot (the last): an ended walk at level 0.
   Set(itT.size() - 1, GridWalkState{}, 0.f);
@@ -459,6 +513,12 @@ void GridWalkLanes::Set(size_t i, const GridWalkState& s, float walkTau) {
   level[i] = s.level;
   node[i] = (int32_t)s.node;
   segments[i] = 0;
+}
+
+void StartWalks(const MajorantGridView& grid, const float* const o[3], const float* const d[3], const float* t0,
+                const float* t1, size_t count, GridWalkLanes& walks) {
+  MMRTM_DCHECK(walks.itT.size() >= count + kPad + 1);
+  HWY_DYNAMIC_DISPATCH(StartWalksLanes)(grid, o, d, t0, t1, count, walks);
 }
 
 bool GridWalkLanesFit(const MajorantGridView& grid) {

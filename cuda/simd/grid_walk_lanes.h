@@ -32,13 +32,20 @@ struct GridWalkLanes {
   std::vector<int32_t> cell[3], level, node;
   std::vector<int32_t> segments;  // the result
 
-  // Room for at least n walks, and the scratch slot after them (an ended
-  // walk): the slots a caller does not Set keep what they held.
+  // Room for at least n walks (and whole vectors past them), and the
+  // scratch slot after them (an ended walk): the slots a caller does not
+  // set keep what they held.
   void Resize(size_t n);
   // Walk i from a scalar walk's state (`tau`: its optical depth to the first
   // arrival).
   void Set(size_t i, const GridWalkState& s, float tau);
 };
+
+// Walks [0, count) of `walks` (Resize(count) or more) start as
+// GridMajorantIterator's constructor starts them for the index rays
+// (o, d) over [t0, t1), scale 1, in lanes; tau is left to the caller.
+void StartWalks(const MajorantGridView& grid, const float* const o[3], const float* const d[3], const float* t0,
+                const float* t1, size_t count, GridWalkLanes& walks);
 
 // Whether the lanes can walk `grid`: its node indices fit 32 bits.
 bool GridWalkLanesFit(const MajorantGridView& grid);

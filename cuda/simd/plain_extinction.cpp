@@ -56,6 +56,7 @@ HWY_FLATTEN void PlainExtinctionLanes(const Classifier& classifier, const float*
 }
 
 const char* TargetNameLanes() { return hwy::TargetName(HWY_TARGET); }
+int FloatLanes() { return (int)hn::Lanes(DF()); }
 
 }  // namespace HWY_NAMESPACE
 }  // namespace mmrtm
@@ -66,6 +67,7 @@ namespace mmrtm {
 
 HWY_EXPORT(PlainExtinctionLanes);
 HWY_EXPORT(TargetNameLanes);
+HWY_EXPORT(FloatLanes);
 
 void PlainExtinctionSimd(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
                          float* sigma_t) {
@@ -89,6 +91,7 @@ void PlainExtinctionScalar(const Classifier& classifier, const float* x, const f
 }
 
 const char* PlainExtinctionTarget() { return HWY_DYNAMIC_DISPATCH(TargetNameLanes)(); }
+int PlainExtinctionLaneCount() { return HWY_DYNAMIC_DISPATCH(FloatLanes)(); }
 
 }  // namespace mmrtm
 #endif  // HWY_ONCE

@@ -30,7 +30,9 @@ void PlainExtinctionSimd(const Classifier& classifier, const float* x, const flo
 void PlainExtinctionScalar(const Classifier& classifier, const float* x, const float* y, const float* z, size_t count,
                            float* sigma_t);
 
-// The Highway target that PlainExtinctionSimd runs on now ("AVX3", "AVX2", ...).
+// The Highway target that PlainExtinctionSimd runs on now ("AVX3", "AVX2", ...),
+// and its floats a vector (16, 8, ...).
 const char* PlainExtinctionTarget();
+int PlainExtinctionLaneCount();
 
 }  // namespace mmrtm

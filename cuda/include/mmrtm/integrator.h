@@ -257,6 +257,11 @@ struct CameraSample {
     ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
     tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
   }
+  // A sample whose numbers, ray and end were made elsewhere (the CPU's SIMD
+  // lanes make them with CameraSample's operations:
+  // cuda/simd/camera_path_starts.h).
+  MMRTM_CPU_GPU CameraSample(PCG32 rng_, SobolPairs pairs_, bool sobol_, Ray ray_, float tMax_)
+      : rng(rng_), pairs(pairs_), sobol(sobol_), ray(ray_), tMax(tMax_) {}
   MMRTM_CPU_GPU const SobolPairs* Pairs() const { return sobol ? &pairs : nullptr; }
   // The camera vertex's pair of the free path (its first arrival and its
   // real-or-null choice), or negatives (drawn from rng).

@@ -9,12 +9,18 @@
 
 namespace mmrtm {
 
+// The constants of the hashes and the generator below, named for the SIMD
+// lanes that compute the same numbers (cuda/simd/camera_path_starts.cpp).
+constexpr uint64_t kMixBitsMultiplier0 = 0x7fb5d329728ea185ULL, kMixBitsMultiplier1 = 0x81dadef4bc2dd44dULL;
+constexpr uint64_t kPCG32Multiplier = 0x5851f42d4c957f2dULL;
+constexpr uint64_t kPixelSequenceSalt = 0x9e3779b97f4a7c15ULL, kSampleOffsetMultiplier = 0x2545f4914f6cdd1dULL;
+
 // 64-bit finaliser of MurmurHash3: spreads nearby integers over all bits.
 MMRTM_CPU_GPU inline uint64_t MixBits(uint64_t v) {
   v ^= v >> 31;
-  v *= 0x7fb5d329728ea185ULL;
+  v *= kMixBitsMultiplier0;
   v ^= v >> 27;
-  v *= 0x81dadef4bc2dd44dULL;
+  v *= kMixBitsMultiplier1;
   v ^= v >> 33;
   return v;
 }
@@ -30,6 +36,15 @@ class PCG32 {
  public:
   MMRTM_CPU_GPU PCG32() { SetSequence(0, 0x853c49e6748fea9bULL); }
   MMRTM_CPU_GPU PCG32(uint64_t sequence, uint64_t offset) { SetSequence(sequence, offset); }
+  // The generator whose state and increment are these (State(), Inc()).
+  MMRTM_CPU_GPU static PCG32 FromState(uint64_t state, uint64_t inc) {
+    PCG32 g(Uninitialised{});
+    g.state_ = state;
+    g.inc_ = inc;
+    return g;
+  }
+  MMRTM_CPU_GPU uint64_t State() const { return state_; }
+  MMRTM_CPU_GPU uint64_t Inc() const { return inc_; }
 
   // Selects stream `sequence`, starting at a state derived from `offset`.
   MMRTM_CPU_GPU void SetSequence(uint64_t sequence, uint64_t offset) {
@@ -42,7 +57,7 @@ class PCG32 {
 
   MMRTM_CPU_GPU uint32_t NextU32() {
     uint64_t old = state_;
-    state_ = old * 0x5851f42d4c957f2dULL + inc_;
+    state_ = old * kPCG32Multiplier + inc_;
     uint32_t xorshifted = (uint32_t)(((old >> 18u) ^ old) >> 27u);
     uint32_t rot = (uint32_t)(old >> 59u);
     return (xorshifted >> rot) | (xorshifted << ((~rot + 1u) & 31));
@@ -52,13 +67,15 @@ class PCG32 {
   MMRTM_CPU_GPU float Uniform() { return UniformFloat(NextU32()); }
 
  private:
+  struct Uninitialised {};
+  MMRTM_CPU_GPU explicit PCG32(Uninitialised) {}
   uint64_t state_, inc_;
 };
 
 // The random stream of one pixel sample.
 MMRTM_CPU_GPU inline PCG32 PixelSampleRNG(uint64_t seed, uint64_t pixelIndex, uint64_t sampleIndex) {
-  uint64_t sequence = MixBits(pixelIndex ^ MixBits(seed + 0x9e3779b97f4a7c15ULL));
-  uint64_t offset = MixBits(sampleIndex * 0x2545f4914f6cdd1dULL + seed);
+  uint64_t sequence = MixBits(pixelIndex ^ MixBits(seed + kPixelSequenceSalt));
+  uint64_t offset = MixBits(sampleIndex * kSampleOffsetMultiplier + seed);
   return PCG32(sequence, offset);
 }
 

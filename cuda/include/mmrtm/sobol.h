@@ -67,12 +67,13 @@ MMRTM_CPU_GPU inline uint32_t SobolDimension1Reversed(uint32_t index) {
 // An Owen scramble of a fraction given with its bits reversed: each bit
 // flipped by a hash of the bits above it (pbrt-v4's FastOwenScrambler,
 // which reverses before and after); returns the scrambled fraction.
+constexpr uint32_t kOwenMultiplier0 = 0x3d20adeau, kOwenMultiplier1 = 0x05526c56u, kOwenMultiplier2 = 0x53a22864u;
 MMRTM_CPU_GPU inline uint32_t OwenScrambleReversed(uint32_t v, uint32_t seed) {
-  v ^= v * 0x3d20adeau;
+  v ^= v * kOwenMultiplier0;
   v += seed;
   v *= (seed >> 16) | 1u;
-  v ^= v * 0x05526c56u;
-  v ^= v * 0x53a22864u;
+  v ^= v * kOwenMultiplier1;
+  v ^= v * kOwenMultiplier2;
   return ReverseBits32(v);
 }
 
@@ -80,16 +81,29 @@ MMRTM_CPU_GPU inline uint32_t OwenScrambleReversed(uint32_t v, uint32_t seed) {
 MMRTM_CPU_GPU inline uint32_t SobolReplicate(uint32_t sampleIndex) { return sampleIndex & 1u; }
 
 // The low-discrepancy pairs of one pixel sample, computed when asked for.
+// The constants of the pairs' hashes (named for the SIMD lanes, as rng.h's).
+constexpr uint64_t kSobolKeySalt = 0x5851f42d4c957f2dULL, kSobolReplicateMultiplier = 0xda942042e4dd58b5ULL;
+constexpr uint64_t kSobolPairMultiplier = 0x9e3779b97f4a7c15ULL;
+
 class SobolPairs {
  public:
   MMRTM_CPU_GPU SobolPairs(uint64_t seed, uint64_t pixelIndex, uint32_t sampleIndex)
       : key_(MixBits(pixelIndex ^
-                     MixBits(seed + 0x5851f42d4c957f2dULL + SobolReplicate(sampleIndex) * 0xda942042e4dd58b5ULL))),
+                     MixBits(seed + kSobolKeySalt + SobolReplicate(sampleIndex) * kSobolReplicateMultiplier))),
         reversedIndex_(ReverseBits32(sampleIndex >> 1)) {}
+  // The pairs whose key and reversed index are these (Key(), ReversedIndex()).
+  MMRTM_CPU_GPU static SobolPairs FromKey(uint64_t key, uint32_t reversedIndex) {
+    SobolPairs p;
+    p.key_ = key;
+    p.reversedIndex_ = reversedIndex;
+    return p;
+  }
+  MMRTM_CPU_GPU uint64_t Key() const { return key_; }
+  MMRTM_CPU_GPU uint32_t ReversedIndex() const { return reversedIndex_; }
 
   // Pair `pair`, uniform on [0, 1)^2.
   MMRTM_CPU_GPU void Get(int pair, float* u0, float* u1) const {
-    const uint64_t h = MixBits(key_ + (uint64_t)(pair + 1) * 0x9e3779b97f4a7c15ULL);
+    const uint64_t h = MixBits(key_ + (uint64_t)(pair + 1) * kSobolPairMultiplier);
     // Burley's shuffle: the index Owen-scrambled (as a fraction, whose
     // reversed bits are the index's), so bit k flips by the bits above it.
     const uint32_t index = OwenScrambleReversed(reversedIndex_, (uint32_t)MixBits(h));
@@ -98,6 +112,7 @@ class SobolPairs {
   }
 
  private:
+  SobolPairs() = default;
   uint64_t key_;
   uint32_t reversedIndex_;  // the sample index, bits reversed
 };
