@@ -77,9 +77,10 @@ options:
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
                         cpu, or cuda (an error without a CUDA device)
-  --simd M              the CPU's tracker: auto (the faster for the scene; today
-                        the scalar one everywhere; default), on (camera rays in
-                        SIMD lanes where this build and CPU have them) or off
+  --simd M              the CPU's tracker: auto (the faster for the scene: camera
+                        rays in SIMD lanes on AVX2 and AVX-512 CPUs with the Sobol'
+                        sampler and a pinhole camera, else scalar; default), on
+                        (the lanes where this build and CPU have them) or off
                         (scalar); the same image to the last bit
   --estimator E         delta (unbiased, default) or raymarch (biased baseline)
   --accelerator A       majorants for delta tracking: none (one global majorant),

@@ -144,10 +144,12 @@ public:
   };
   ///@{
   /**
-   * The CPU's tracker: AUTO (default) the faster for the scene (today the
-   * scalar one everywhere), ON camera rays in SIMD lanes where this build
-   * and CPU have them, OFF the scalar one. The same image to the last bit
-   * either way, so a change keeps the accumulation. mmrtm-render's --simd.
+   * The CPU's tracker: AUTO (default) the faster for the scene (camera rays
+   * in SIMD lanes on AVX2 and AVX-512 CPUs with the Sobol' sampler and a
+   * pinhole camera, else scalar), ON the lanes where this build and CPU
+   * have them, OFF the scalar one. The same image to the last bit either
+   * way, so a change keeps the accumulation. GetBackendDescription says
+   * which rendered. mmrtm-render's --simd.
    */
   virtual void SetCpuSimd(int mode);
   vtkGetMacro(CpuSimd, int);
