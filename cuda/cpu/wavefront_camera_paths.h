@@ -1,12 +1,13 @@
-// The camera stage of the CPU's SIMD backend (--simd on; issue 34): a
-// batch of pixel samples started in SIMD lanes (their numbers, camera rays
-// and walks' starts: cuda/simd/camera_path_starts.h), their camera rays
-// delta-tracked together in lanes (cuda/simd/grid_walk_lanes.h: the
-// majorant walk and a plain scene's lookups, a lane a ray), each ray's
-// real-or-null choices made with its own random numbers in DeltaTrack's
-// order, and the real collision classified by the scalar classifier. A path's free path is the one
-// DeltaTrack samples, to the last bit; the rest of the path is the scalar
-// integrator (Li, given the free path: wavefront_tile.h).
+// The camera stage of the CPU's SIMD backend (--simd on, and auto where it
+// is faster; issue 34): a batch of pixel samples started in SIMD lanes
+// (their numbers, camera rays and walks' starts:
+// cuda/simd/camera_path_starts.h), their camera rays delta-tracked
+// together in lanes (cuda/simd/grid_walk_lanes.h: the majorant walk and a
+// plain scene's lookups, a lane a ray), each ray's real-or-null choices
+// made with its own random numbers in DeltaTrack's order, and the real
+// collision classified by the scalar classifier. A path's free path is the
+// one DeltaTrack samples, to the last bit; the rest of the path is the
+// scalar integrator (Li, given the free path: wavefront_tile.h).
 #pragma once
 
 #include <cstdint>
@@ -54,12 +55,11 @@ class WavefrontCameraPaths {
   static bool Runs(const SceneView& s);
   // Whether they run `s`'s camera stage faster than the scalar tracker
   // does (--simd auto): where they run, start the paths too (the Sobol'
-  // sampler, a pinhole), and have 8 lanes or more (AVX2, AVX-512:
-  // kFasterLanes). Measured
-  // on the head CT's camera stage: 16 lanes 1.42-1.45 times as fast, 8
-  // lanes 1.10-1.12, 4 lanes (SSE4) 0.78-0.81; with the paths started by
-  // the scalar code, 16 lanes 1.06, 8 lanes 0.90 (Documentation/performance.md,
-  // "SIMD lanes: the camera stage").
+  // sampler, a pinhole), and have kFasterLanes lanes or more (AVX2,
+  // AVX-512). Measured on the head CT's camera stage: 16 lanes 1.42-1.45
+  // times as fast, 8 lanes 1.10-1.12, 4 lanes (SSE4) 0.78-0.81; with the
+  // paths started by the scalar code, 16 lanes 1.06, 8 lanes 0.90
+  // (Documentation/performance.md, "SIMD lanes: the camera stage").
   static bool Faster(const SceneView& s);
   static constexpr int kFasterLanes = 8;
 

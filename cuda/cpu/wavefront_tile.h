@@ -1,5 +1,5 @@
 // One image tile on the CPU's SIMD backend: the tile's pixel samples, in
-// batches, have their camera rays tracked together
+// batches, have their camera rays started and tracked together
 // (wavefront_camera_paths.h), then each path goes on in the scalar
 // integrator (Li, given its free path). Samples are added to the film in
 // the scalar loop's order (pixel by pixel, sample index by index), so the
@@ -25,7 +25,8 @@ class WavefrontTile {
 
   // Paths tracked together: enough that the lanes, refilled as rays
   // collide, stay full but for the batch's last rays; few enough for their
-  // state (about 0.4 KiB each) to stay in the core's L2 cache.
+  // state (about 0.4 KiB each: the path, its start and its walk) to stay
+  // in the core's L2 cache.
   static constexpr size_t kBatchPaths = 1024;
 
  private:

@@ -64,10 +64,15 @@ MMRTM_CPU_GPU inline uint32_t SobolDimension1Reversed(uint32_t index) {
   return index;
 }
 
+// The constants of the scramble and of the pairs' hashes below, named for
+// the SIMD lanes that compute the same numbers, as rng.h's.
+constexpr uint32_t kOwenMultiplier0 = 0x3d20adeau, kOwenMultiplier1 = 0x05526c56u, kOwenMultiplier2 = 0x53a22864u;
+constexpr uint64_t kSobolKeySalt = 0x5851f42d4c957f2dULL, kSobolReplicateMultiplier = 0xda942042e4dd58b5ULL;
+constexpr uint64_t kSobolPairMultiplier = 0x9e3779b97f4a7c15ULL;
+
 // An Owen scramble of a fraction given with its bits reversed: each bit
 // flipped by a hash of the bits above it (pbrt-v4's FastOwenScrambler,
 // which reverses before and after); returns the scrambled fraction.
-constexpr uint32_t kOwenMultiplier0 = 0x3d20adeau, kOwenMultiplier1 = 0x05526c56u, kOwenMultiplier2 = 0x53a22864u;
 MMRTM_CPU_GPU inline uint32_t OwenScrambleReversed(uint32_t v, uint32_t seed) {
   v ^= v * kOwenMultiplier0;
   v += seed;
@@ -81,10 +86,6 @@ MMRTM_CPU_GPU inline uint32_t OwenScrambleReversed(uint32_t v, uint32_t seed) {
 MMRTM_CPU_GPU inline uint32_t SobolReplicate(uint32_t sampleIndex) { return sampleIndex & 1u; }
 
 // The low-discrepancy pairs of one pixel sample, computed when asked for.
-// The constants of the pairs' hashes (named for the SIMD lanes, as rng.h's).
-constexpr uint64_t kSobolKeySalt = 0x5851f42d4c957f2dULL, kSobolReplicateMultiplier = 0xda942042e4dd58b5ULL;
-constexpr uint64_t kSobolPairMultiplier = 0x9e3779b97f4a7c15ULL;
-
 class SobolPairs {
  public:
   MMRTM_CPU_GPU SobolPairs(uint64_t seed, uint64_t pixelIndex, uint32_t sampleIndex)
