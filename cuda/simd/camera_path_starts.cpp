@@ -7,8 +7,6 @@
 // (mmrtm/scene_view.h) and IntersectBox (mmrtm/ray.h).
 #include "camera_path_starts.h"
 
-#include <limits>
-
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "simd/camera_path_starts.cpp"
 #include <hwy/foreach_target.h>  // must come before highway.h
@@ -259,8 +257,10 @@ constexpr size_t kPad = 256 / sizeof(float);
 void CameraPathStarts::Resize(size_t n) {
   size_ = n;
   const size_t padded = n + kPad;
-  for (auto* v : {&x, &y}) v->assign(padded, 0);
-  sampleIndex.assign(padded, 0);
+  // The padding's inputs are zeros or earlier samples: valid pixels, whose
+  // starts are computed and dropped.
+  for (auto* v : {&x, &y}) v->resize(padded);
+  sampleIndex.resize(padded);
   for (auto* v : {&rngState, &rngInc, &sobolKey}) v->resize(padded);
   sobolReversedIndex.resize(padded);
   for (int a = 0; a < 3; ++a)

@@ -6,7 +6,6 @@
 #include "grid_walk_lanes.h"
 
 #include <cstring>
-#include <limits>
 #include <optional>
 #include <type_traits>
 
@@ -378,8 +377,7 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       hn::Store(az, df, pz);
       hn::Store(w.walkT, df, laneT);
       hn::Store(w.segMaj, df, laneMaj);
-      hn::Store(w.tau, df, laneTau);
-      hn::Store(id, di, laneId);
+      hn::Store(w.tau, df, laneTau);  // laneId holds id since the last refill
       uint8_t arrivedBits[8] = {};
       hn::StoreMaskBits(df, arrived, arrivedBits);
       uint64_t pending;

@@ -52,10 +52,11 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, V
 // sigma_maj; `scale` multiplies the extinction and the majorants): the
 // ray's interval in the domain, the majorant walk built in place (a copy
 // of the grid walk's state costs about 55 instructions: mmrtm/majorant.h)
-// and the optical depth to the first arrival. SampleTentativeCollisions
-// walks on from it; the CPU's SIMD lanes take it over for many rays
-// (cuda/simd/grid_walk_lanes.h), each drawing its own random numbers in
-// the same order.
+// and the optical depth to the first arrival: SampleTentativeCollisions'
+// first steps (which it takes in locals), as a struct for the CPU's SIMD
+// lanes where they do not start the paths themselves
+// (cuda/cpu/wavefront_camera_paths.cpp) and for the tests that hold the
+// lanes' own start to it.
 struct TentativeCollisionStart {
   Ray indexRay;
   float t0, t1;
