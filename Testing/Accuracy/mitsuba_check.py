@@ -4,12 +4,14 @@ volumetric scene, and the two images must agree within their noise.
 
     Testing/Accuracy/mitsuba_check.py             # 128 x 128, 2048 spp: the report's figures (~10 min)
     Testing/Accuracy/mitsuba_check.py --ci        # 48 x 48, a pass/fail test (CTest)
+    Testing/Accuracy/mitsuba_check.py --volume bonsai --size 96 --spp 512   # the second volume
 
-The scene: the head CT ct_head_headsq.nrrd (64 x 64 x 93 voxels) through a
-density CCTF and an albedo CCTF, evaluated here at the voxels into two grids,
-an extinction grid (sigma_t / sigma_max) and an albedo-parameter grid (the
-albedo is a linear function of it). Both renderers read exactly these grids
-and interpolate them trilinearly between voxel centres, so the medium is the
+The scene: a volume (`--volume`: the head CT ct_head_headsq.nrrd, 64 x 64 x
+93 voxels, by default; or the bonsai CT, 256^3) through a density CCTF and
+an albedo CCTF, evaluated here at the voxels into two grids, an extinction
+grid (sigma_t / sigma_max) and an albedo-parameter grid (the albedo is a
+linear function of it). Both renderers read exactly these grids and
+interpolate them trilinearly between voxel centres, so the medium is the
 same point for point:
   - mmrtm-render reads them as two proxies through identity TFs (a CCTF from
     0 to 1 on the extinction, a linear colour ramp on the albedo parameter);
@@ -52,11 +54,23 @@ import mmrtm_accuracy as acc  # noqa: E402
 
 SKIP = 77  # CTest's SKIP_RETURN_CODE
 
-# The medium, as TFs over the CT values of ct_head_headsq.nrrd (0 .. ~3300).
-DENSITY_POINTS = [(600.0, 0.0), (1000.0, 0.25), (1400.0, 1.0)]  # x, density in 0..1
-SIGMA_MAX = 0.35  # extinction per mm where the density TF gives 1
-ALBEDO_RANGE = (900.0, 1600.0)  # albedo parameter 0..1 over these CT values
-ALBEDO_LOW, ALBEDO_HIGH = (0.85, 0.45, 0.35), (0.97, 0.95, 0.9)
+# The media, as TFs over each volume's values: the density points (x,
+# density in 0..1), the extinction per mm where the density is 1, the values
+# over which the albedo parameter goes from 0 to 1 and the albedos there,
+# and the direction the camera looks from (world, z up).
+VOLUMES = {
+    # CT values 0 .. ~3300: bone and skin.
+    "headsq": {"file": "ct_head_headsq.nrrd", "density_points": [(600.0, 0.0), (1000.0, 0.25), (1400.0, 1.0)],
+               "sigma_max": 0.35, "albedo_range": (900.0, 1600.0),
+               "albedo_low": (0.85, 0.45, 0.35), "albedo_high": (0.97, 0.95, 0.9),
+               # From the anterior-left side and a little above, as a user would look at a head.
+               "view_from": (0.55, -1.0, 0.35)},
+    # Values 0 .. 255: leaves green, trunk and pot brown (Data/benchmarks/bonsai.json's density TF).
+    "bonsai": {"file": "bonsai.nii.gz", "density_points": [(25.0, 0.0), (60.0, 0.6), (200.0, 1.0)],
+               "sigma_max": 0.5, "albedo_range": (30.0, 200.0),
+               "albedo_low": (0.35, 0.7, 0.25), "albedo_high": (0.7, 0.55, 0.4),
+               "view_from": (0.35, -1.0, 0.3)},
+}
 G = 0.3
 ENVIRONMENT = (0.35, 0.4, 0.5)
 SUN_DIRECTION = (0.45, 0.6, -0.66)  # direction of travel, world (LPS)
@@ -83,6 +97,21 @@ def read_nrrd(path):
     return data.astype(np.float64), spacing
 
 
+def read_nifti_uint8(path):
+    """The few NIfTI-1 fields bonsai.nii.gz uses: gzip, uint8, no scaling."""
+    import gzip
+    import struct
+    raw = gzip.open(path, "rb").read()
+    dim = struct.unpack("<8h", raw[40:56])
+    datatype = struct.unpack("<h", raw[70:72])[0]
+    spacing = list(struct.unpack("<3f", raw[80:92]))
+    offset = int(struct.unpack("<f", raw[108:112])[0])
+    if dim[0] != 3 or datatype != 2:
+        raise SystemExit(f"{path}: expected a 3D uint8 NIfTI volume")
+    data = np.frombuffer(raw, dtype=np.uint8, offset=offset, count=dim[1] * dim[2] * dim[3])
+    return data.reshape(dim[3], dim[2], dim[1]).astype(np.float64), spacing  # (z, y, x)
+
+
 def write_nrrd(path, grid, spacing):
     """A float NRRD with LPS geometry, origin 0, axis-aligned."""
     nz, ny, nx = grid.shape
@@ -95,33 +124,34 @@ def write_nrrd(path, grid, spacing):
         f.write(np.ascontiguousarray(grid, dtype="<f4").tobytes())
 
 
-def make_grids():
-    values, spacing = read_nrrd(acc.DATA / "ct_head_headsq.nrrd")
-    xs, ys = zip(*DENSITY_POINTS)
+def make_grids(volume):
+    path = acc.DATA / volume["file"]
+    values, spacing = read_nrrd(path) if path.suffix == ".nrrd" else read_nifti_uint8(path)
+    xs, ys = zip(*volume["density_points"])
     density = np.interp(values, xs, ys)
-    albedo_t = np.clip((values - ALBEDO_RANGE[0]) / (ALBEDO_RANGE[1] - ALBEDO_RANGE[0]), 0.0, 1.0)
+    low, high = volume["albedo_range"]
+    albedo_t = np.clip((values - low) / (high - low), 0.0, 1.0)
     return density, albedo_t, spacing
 
 
-def camera(density, spacing):
+def camera(volume, density, spacing):
     nz, ny, nx = density.shape
     extent = np.array([(nx - 1) * spacing[0], (ny - 1) * spacing[1], (nz - 1) * spacing[2]])
     centre = extent / 2
-    # From the anterior-left side and a little above, as a user would look at a head.
-    direction = np.array([0.55, -1.0, 0.35])
+    direction = np.array(volume["view_from"])
     direction /= np.linalg.norm(direction)
     position = centre + direction * 1.5 * np.linalg.norm(extent)
     return {"position": position.tolist(), "look_at": centre.tolist(), "up": [0.0, 0.0, 1.0], "fov": 30.0}, extent
 
 
-def render_ours(folder, cam, size, spp, seed, shadow_scale=1.0):
+def render_ours(volume, folder, cam, size, spp, seed, shadow_scale=1.0):
     scene = {
         "volumes": {"scalars": {"file": "extinction.nrrd"}, "albedo_t": {"file": "albedo_t.nrrd"}},
         "materials": {"medium": {
-            "density": SIGMA_MAX, "albedo": [1, 1, 1], "anisotropy": G, "surface_probability": 0,
+            "density": volume["sigma_max"], "albedo": [1, 1, 1], "anisotropy": G, "surface_probability": 0,
             "tfs": {"density": [{"type": "cctf", "proxy": "scalars", "points": [[0, 0], [1, 1]]}],
                     "albedo": [{"type": "cctf", "proxy": "albedo_t",
-                                "points": [[0, *ALBEDO_LOW], [1, *ALBEDO_HIGH]]}]}}},
+                                "points": [[0, *volume["albedo_low"]], [1, *volume["albedo_high"]]]}]}}},
         "lights": [{"type": "environment", "color": list(ENVIRONMENT)},
                    {"type": "directional", "direction": list(SUN_DIRECTION), "color": list(SUN_IRRADIANCE),
                     "intensity": 1.0}],
@@ -168,10 +198,11 @@ def mitsuba_scene(variant, sigma_t, albedo, scale, spacing, extent, cam, size, s
     })
 
 
-def render_mitsuba(variant, density, albedo_t, spacing, extent, cam, size, spp, batches):
+def render_mitsuba(variant, volume, density, albedo_t, spacing, extent, cam, size, spp, batches):
     import mitsuba as mi
-    albedo = (np.array(ALBEDO_LOW) + albedo_t[..., None] * (np.array(ALBEDO_HIGH) - np.array(ALBEDO_LOW)))
-    scene = mitsuba_scene(variant, density[..., None], albedo, SIGMA_MAX, spacing, extent, cam, size, spp)
+    low, high = np.array(volume["albedo_low"]), np.array(volume["albedo_high"])
+    albedo = low + albedo_t[..., None] * (high - low)
+    scene = mitsuba_scene(variant, density[..., None], albedo, volume["sigma_max"], spacing, extent, cam, size, spp)
     images, seconds = [], 0.0
     for b in range(batches):
         start = time.time()
@@ -224,6 +255,7 @@ def figure(ours, mitsuba, result, path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--ci", action="store_true", help="48 x 48, few samples: the CTest check")
+    parser.add_argument("--volume", choices=sorted(VOLUMES), default="headsq", help="the medium's volume")
     parser.add_argument("--size", type=int)
     parser.add_argument("--spp", type=int, help="our samples per pixel")
     parser.add_argument("--mitsuba-spp", type=int, help="Mitsuba's samples per pixel per batch")
@@ -242,26 +274,27 @@ def main():
         print("SKIPPED: Mitsuba 3 is not installed for this Python "
               f"({sys.executable}); scripts/install-dependencies.sh installs it in .venv")
         return SKIP
-    density, albedo_t, spacing = make_grids()
-    cam, extent = camera(density, spacing)
+    volume = VOLUMES[args.volume]
+    density, albedo_t, spacing = make_grids(volume)
+    cam, extent = camera(volume, density, spacing)
     with tempfile.TemporaryDirectory() as tmp:
         write_nrrd(Path(tmp) / "extinction.nrrd", density, spacing)
         write_nrrd(Path(tmp) / "albedo_t.nrrd", albedo_t, spacing)
         start = time.time()
-        ours = render_ours(tmp, cam, size, spp, seed=3)
+        ours = render_ours(volume, tmp, cam, size, spp, seed=3)
         ours_seconds = ours.seconds
         print(f"mmrtm-render: {size}^2, {spp} spp, {ours_seconds:.2f} s render ({time.time() - start:.1f} s in all)")
         # The check must be able to fail: a slightly biased render (shadow rays
         # see 0.9 of the extinction) has to be told apart from Mitsuba's.
-        biased = render_ours(tmp, cam, size, spp, seed=4, shadow_scale=0.9) if args.ci else None
-    mi_mean, mi_var, mi_batches, mi_seconds = render_mitsuba(args.variant, density, albedo_t, spacing, extent, cam, size,
-                                                 mi_spp, args.batches)
+        biased = render_ours(volume, tmp, cam, size, spp, seed=4, shadow_scale=0.9) if args.ci else None
+    mi_mean, mi_var, mi_batches, mi_seconds = render_mitsuba(args.variant, volume, density, albedo_t, spacing, extent,
+                                                             cam, size, mi_spp, args.batches)
     print(f"Mitsuba {args.variant}: {size}^2, {args.batches} x {mi_spp} spp, {mi_seconds:.2f} s render")
     result = compare(ours.mean, ours.variance, mi_mean, mi_var, spp, mi_batches)
     ours_noise = acc.relative_noise(ours.mean, ours.variance)
     mi_noise = acc.relative_noise(mi_mean, mi_var)
     # Time to reach a given relative noise e: t * (noise / e)^2; the ratio does not depend on e.
-    result.update({"size": size, "ours_spp": spp, "ours_seconds": ours_seconds, "ours_noise": ours_noise,
+    result.update({"volume": args.volume, "size": size, "ours_spp": spp, "ours_seconds": ours_seconds, "ours_noise": ours_noise,
                    "mitsuba_variant": args.variant, "mitsuba_spp": mi_spp * args.batches,
                    "mitsuba_seconds": mi_seconds, "mitsuba_noise": mi_noise,
                    "time_to_equal_error_ratio": (mi_seconds * mi_noise ** 2) / (ours_seconds * ours_noise ** 2),
@@ -276,7 +309,8 @@ def main():
         acc.write_pfm(out / "mitsuba_variance.pfm", mi_var)
         (out / "mitsuba_check.json").write_text(json.dumps(result, indent=1))
         if not args.ci:
-            figure(ours.mean, mi_mean, result, acc.DOC_IMAGES / "mitsuba_check.png")
+            name = "mitsuba_check.png" if args.volume == "headsq" else f"mitsuba_check_{args.volume}.png"
+            figure(ours.mean, mi_mean, result, acc.DOC_IMAGES / name)
     ok = acc.agrees(result) and result["mean_luminance"] > 0.01
     if args.ci:
         # The power (the smallest change of a channel's mean over the covered

@@ -11,7 +11,7 @@ bench_binaries_ab.py for the time). Only the render part is counted
 build; one thread, shadow scale 1.
 
     .venv/bin/python Testing/Benchmarks/callgrind_binaries_ab.py A/bin/mmrtm-render B/bin/mmrtm-render \\
-        [--size 48] [--spp 8] [--only NAME ...]
+        [--size 48] [--spp 8] [--simd auto|on|off] [--only NAME ...]
 
 Needs valgrind and the shared data (MMRTM_SHARED_DATA_DIR or ../shared/data).
 Takes about five minutes at the defaults.
@@ -30,11 +30,11 @@ import mmrtm_accuracy as acc  # noqa: E402
 RENDER_PART = "mmrtm::CpuRenderer::RenderRanges*::{lambda(int)#1}::operator()*"
 
 
-def count(binary, args, size, spp, image):
+def count(binary, args, size, spp, simd, image):
     """The render part's instructions, and the linear image in `image`."""
     cmd = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", f"--toggle-collect={RENDER_PART}",
            str(binary), *map(str, args), "--width", str(size), "--height", str(size), "--spp", str(spp),
-           "--seed", "3", "--threads", "1", "--backend", "cpu", "--shadow-scale", "1", "--quiet",
+           "--seed", "3", "--threads", "1", "--backend", "cpu", "--simd", simd, "--shadow-scale", "1", "--quiet",
            "--output", str(image.with_suffix(".png")), "--output-linear", str(image)]
     done = subprocess.run(cmd, capture_output=True, text=True)
     refs = re.search(r"I\s+refs:\s+([\d,]+)", done.stderr)
@@ -49,6 +49,8 @@ def main():
     parser.add_argument("b")
     parser.add_argument("--size", type=int, default=48)
     parser.add_argument("--spp", type=int, default=8)
+    parser.add_argument("--simd", default="auto", choices=["auto", "on", "off"],
+                        help="the CPU tracker of both builds (mmrtm-render --simd)")
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     args = parser.parse_args()
     print("| scene | A instructions | B instructions | B / A | images |")
@@ -56,7 +58,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.only or list(acc.SCENES):
             images = [Path(tmp) / f"{name}_{key}.pfm" for key in ("a", "b")]
-            a, b = (count(binary, acc.SCENES[name]["args"], args.size, args.spp, image)
+            a, b = (count(binary, acc.SCENES[name]["args"], args.size, args.spp, args.simd, image)
                     for binary, image in zip((args.a, args.b), images))
             same = images[0].read_bytes() == images[1].read_bytes()
             print(f"| {acc.SCENES[name]['title']} | {a / 1e6:.1f} M | {b / 1e6:.1f} M | {b / a:.3f} | "
