@@ -294,8 +294,8 @@ def main():
     ours_noise = acc.relative_noise(ours.mean, ours.variance)
     mi_noise = acc.relative_noise(mi_mean, mi_var)
     # Time to reach a given relative noise e: t * (noise / e)^2; the ratio does not depend on e.
-    result.update({"volume": args.volume, "size": size, "ours_spp": spp, "ours_seconds": ours_seconds, "ours_noise": ours_noise,
-                   "mitsuba_variant": args.variant, "mitsuba_spp": mi_spp * args.batches,
+    result.update({"volume": args.volume, "size": size, "ours_spp": spp, "ours_seconds": ours_seconds,
+                   "ours_noise": ours_noise, "mitsuba_variant": args.variant, "mitsuba_spp": mi_spp * args.batches,
                    "mitsuba_seconds": mi_seconds, "mitsuba_noise": mi_noise,
                    "time_to_equal_error_ratio": (mi_seconds * mi_noise ** 2) / (ours_seconds * ours_noise ** 2),
                    "mean_luminance": float(ours.mean.mean())})
