@@ -50,18 +50,22 @@ class CameraChoices : public ArrivalChoices {
  public:
   CameraChoices(const SceneView& s, std::vector<CameraPath>& paths) : s_(s), paths_(paths) {}
 
-  bool Real(uint32_t i, float t, Vec3 p, float sigma_maj, const float* sigma_t, float* tau) override {
+  bool Real(uint32_t i, float t, Vec3 p, float sigma_maj, const PlainClassification* plain, float* tau) override {
     CameraPath& path = paths_[i];
     Classification c;
-    if (!sigma_t) c = s_.classifier.Classify(path.sample.ray(t), p);
-    const float extinction = sigma_t ? *sigma_t : c.sigma_t;
-    CountLookup(extinction, sigma_maj, 1.f, path.ctr);
-    if (path.choice.Real(extinction, sigma_maj, path.sample.rng, path.ctr)) {
+    if (plain) {
+      // Classify's plain branch, from the lanes' numbers.
+      c.material = 0;
+      c.sigma_t = plain->sigma_t;
+      c.proxies.v[0] = plain->value;
+    } else {
+      c = s_.classifier.Classify(path.sample.ray(t), p);
+    }
+    CountLookup(c.sigma_t, sigma_maj, 1.f, path.ctr);
+    if (path.choice.Real(c.sigma_t, sigma_maj, path.sample.rng, path.ctr)) {
       path.freePath.collided = true;
       path.freePath.t = t;
-      // The lanes gave a plain scene's extinction only: the collision's
-      // whole classification is one more scalar lookup (one a path).
-      path.freePath.c = sigma_t ? s_.classifier.Classify(path.sample.ray(t), p) : c;
+      path.freePath.c = c;
       return true;
     }
     *tau = TentativeCollisionStart::OpticalDepthToArrival(path.sample.rng.Uniform());

@@ -337,7 +337,8 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
   const VI oneI = hn::Set(di, 1), zeroI = hn::Zero(di), scratchI = hn::Set(di, scratch);
   constexpr size_t kMax = HWY_MAX_BYTES / sizeof(float);
   HWY_ALIGN int32_t laneId[kMax], flag[kMax];
-  HWY_ALIGN float laneT[kMax], px[kMax], py[kMax], pz[kMax], laneMaj[kMax], laneSigma[kMax], laneTau[kMax];
+  HWY_ALIGN float laneT[kMax], px[kMax], py[kMax], pz[kMax], laneMaj[kMax], laneSigma[kMax], laneValue[kMax],
+      laneTau[kMax];
   for (size_t k = 0; k < n; ++k) laneId[k] = scratch;
   VI id = hn::Load(di, laneId);
   Walks w;
@@ -371,7 +372,11 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       const VF ax = w.o[0] + w.d[0] * w.walkT, ay = w.o[1] + w.d[1] * w.walkT, az = w.o[2] + w.d[2] * w.walkT;
       ++c.lookupRounds;
       c.lookups += hn::CountTrue(df, arrived);
-      if constexpr (Plain) hn::Store(scene->Extinction(ax, ay, az), df, laneSigma);
+      if constexpr (Plain) {
+        VF value;
+        hn::Store(scene->Extinction(ax, ay, az, &value), df, laneSigma);
+        hn::Store(value, df, laneValue);
+      }
       hn::Store(ax, df, px);
       hn::Store(ay, df, py);
       hn::Store(az, df, pz);
@@ -385,8 +390,9 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       hn::Store(zeroI, di, flag);
       for (; pending; pending &= pending - 1) {
         const int k = __builtin_ctzll(pending);
+        const PlainClassification plain{laneSigma[k], laneValue[k]};
         flag[k] = choices.Real((uint32_t)laneId[k], laneT[k], Vec3{px[k], py[k], pz[k]}, laneMaj[k],
-                               Plain ? &laneSigma[k] : nullptr, &laneTau[k])
+                               Plain ? &plain : nullptr, &laneTau[k])
                       ? 1
                       : 0;
       }

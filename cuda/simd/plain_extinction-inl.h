@@ -138,10 +138,13 @@ struct PlainScene {
         voxels{static_cast<const T*>(volume.data),
                hn::Set(DI(), (int32_t)((int64_t)volume.nx * volume.ny * volume.nz * (int64_t)sizeof(T) - 4))} {}
 
-  // The extinction at index points (px, py, pz): Classifier::Classify's.
-  inline Float Extinction(Float px, Float py, Float pz) const {
-    const Float sigma_t =
-        classifier.PlainExtinction<Lanes>({DensityTFLanes(tf, SampleIndexLanes(volume, voxels, px, py, pz))}).raw;
+  // The extinction at index points (px, py, pz): Classifier::Classify's;
+  // `value`, when given, gets the volume's value there (the
+  // classification's proxy sample).
+  inline Float Extinction(Float px, Float py, Float pz, Float* value = nullptr) const {
+    const Float sample = SampleIndexLanes(volume, voxels, px, py, pz);
+    if (value) *value = sample;
+    const Float sigma_t = classifier.PlainExtinction<Lanes>({DensityTFLanes(tf, sample)}).raw;
     return Planted(Defect::SimdExtinction) ? sigma_t * hn::Set(DF(), 0.98f) : sigma_t;
   }
 };
