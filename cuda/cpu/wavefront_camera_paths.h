@@ -5,7 +5,8 @@
 // together in lanes (cuda/simd/grid_walk_lanes.h: the majorant walk and a
 // plain scene's lookups, a lane a ray), each ray's real-or-null choices
 // made with its own random numbers in DeltaTrack's order, and the real
-// collision classified by the scalar classifier. A path's free path is the
+// collision classified (in a plain scene from the lanes' own lookup,
+// otherwise by the scalar classifier). A path's free path is the
 // one DeltaTrack samples, to the last bit; the rest of the path is the
 // scalar integrator (Li, given the free path: wavefront_tile.h).
 #pragma once
@@ -56,8 +57,8 @@ class WavefrontCameraPaths {
   // Whether they run `s`'s camera stage faster than the scalar tracker
   // does (--simd auto): where they run, start the paths too (the Sobol'
   // sampler, a pinhole), and have kFasterLanes lanes or more (AVX2,
-  // AVX-512). Measured on the head CT's camera stage: 16 lanes 1.42-1.45
-  // times as fast, 8 lanes 1.10-1.12, 4 lanes (SSE4) 0.78-0.81; with the
+  // AVX-512). Measured on the head CT's camera stage: 16 lanes 1.45-1.51
+  // times as fast, 8 lanes 1.13-1.16, 4 lanes (SSE4) 0.81-0.86; with the
   // paths started by the scalar code, 16 lanes 1.06, 8 lanes 0.90
   // (Documentation/performance.md, "SIMD lanes: the camera stage").
   static bool Faster(const SceneView& s);
