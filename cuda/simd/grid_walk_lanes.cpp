@@ -390,7 +390,8 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       hn::Store(zeroI, di, flag);
       for (; pending; pending &= pending - 1) {
         const int k = __builtin_ctzll(pending);
-        const PlainClassification plain{laneSigma[k], laneValue[k]};
+        PlainClassification plain{};
+        if constexpr (Plain) plain = {laneSigma[k], laneValue[k]};
         flag[k] = choices.Real((uint32_t)laneId[k], laneT[k], Vec3{px[k], py[k], pz[k]}, laneMaj[k],
                                Plain ? &plain : nullptr, &laneTau[k])
                       ? 1
