@@ -50,17 +50,9 @@ class CameraChoices : public ArrivalChoices {
  public:
   CameraChoices(const SceneView& s, std::vector<CameraPath>& paths) : s_(s), paths_(paths) {}
 
-  bool Real(uint32_t i, float t, Vec3 p, float sigma_maj, const PlainClassification* plain, float* tau) override {
+  bool Real(uint32_t i, float t, Vec3 p, float sigma_maj, const Classification* plain, float* tau) override {
     CameraPath& path = paths_[i];
-    Classification c;
-    if (plain) {
-      // Classify's plain branch, from the lanes' numbers.
-      c.material = 0;
-      c.sigma_t = plain->sigma_t;
-      c.proxies.v[0] = plain->value;
-    } else {
-      c = s_.classifier.Classify(path.sample.ray(t), p);
-    }
+    const Classification c = plain ? *plain : s_.classifier.Classify(path.sample.ray(t), p);
     CountLookup(c.sigma_t, sigma_maj, 1.f, path.ctr);
     if (path.choice.Real(c.sigma_t, sigma_maj, path.sample.rng, path.ctr)) {
       path.freePath.collided = true;

@@ -388,10 +388,10 @@ void DeltaTrackLanes(const Classifier& classifier, const MajorantGridView& grid,
       uint64_t pending;
       std::memcpy(&pending, arrivedBits, sizeof pending);
       hn::Store(zeroI, di, flag);
+      Classification plain;  // a plain scene's: its fields other than the lanes' numbers stay as made
       for (; pending; pending &= pending - 1) {
         const int k = __builtin_ctzll(pending);
-        PlainClassification plain{};
-        if constexpr (Plain) plain = {laneSigma[k], laneValue[k]};
+        if constexpr (Plain) Classifier::SetPlainClassification(laneValue[k], laneSigma[k], &plain);
         flag[k] = choices.Real((uint32_t)laneId[k], laneT[k], Vec3{px[k], py[k], pz[k]}, laneMaj[k],
                                Plain ? &plain : nullptr, &laneTau[k])
                       ? 1

@@ -50,24 +50,17 @@ void StartWalks(const MajorantGridView& grid, const float* const o[3], const flo
 // Whether the lanes can walk `grid`: its node indices fit 32 bits.
 bool GridWalkLanesFit(const MajorantGridView& grid);
 
-// What the lanes looked up at an arrival in a plain scene: its extinction
-// and the volume's value there, Classifier::Classify's numbers (the
-// classification is {material 0, sigma_t, proxies.v[0] = value}).
-struct PlainClassification {
-  float sigma_t, value;
-};
-
 // The caller's side of delta tracking: the choice at each arrival, made
 // with the walk's own random numbers, one arrival at a time.
 class ArrivalChoices {
  public:
   virtual ~ArrivalChoices() = default;
   // Walk `walk` arrived at distance t, index point p, in a segment of
-  // majorant sigma_maj; `plain`: what the lanes looked up there, or null (a
-  // scene not plain: the caller classifies). True for a real collision (the
-  // walk is over); otherwise sets *tau, the optical depth to the walk's
-  // next arrival.
-  virtual bool Real(uint32_t walk, float t, Vec3 p, float sigma_maj, const PlainClassification* plain, float* tau) = 0;
+  // majorant sigma_maj; `plain`: the classification there from the lanes'
+  // lookup, or null (a scene not plain: the caller classifies). True for a
+  // real collision (the walk is over); otherwise sets *tau, the optical
+  // depth to the walk's next arrival.
+  virtual bool Real(uint32_t walk, float t, Vec3 p, float sigma_maj, const Classification* plain, float* tau) = 0;
 };
 
 // Whether a plain scene's lookups fit the lanes' 32-bit gathers (always

@@ -134,6 +134,14 @@ struct Classifier {
   MMRTM_INLINE MMRTM_CPU_GPU typename L::Float PlainExtinction(typename L::Float density) const {
     return L::Min(L::Splat(materials[0].base[0]) * density, L::Splat(maxExtinction));
   }
+  // Makes *c a plain scene's classification where the volume's value is
+  // `value` and the extinction sigma_t (the SIMD lanes compute both and
+  // classify here too).
+  MMRTM_CPU_GPU static void SetPlainClassification(float value, float sigma_t, Classification* c) {
+    c->proxies.v[0] = value;
+    c->sigma_t = sigma_t;
+    c->material = 0;
+  }
 
   MMRTM_CPU_GPU Classification Classify(Vec3 world) const {
     return Classify(world, proxies[0].worldToIndex.ApplyPoint(world));
@@ -154,8 +162,7 @@ struct Classifier {
       c.proxies.v[0] = proxies[0].SampleIndex(index0);
       float v;
       PlainDensityTF().Evaluate(c.proxies.v[0], &v);
-      c.sigma_t = PlainExtinction<ScalarLanes>(v);
-      c.material = 0;
+      SetPlainClassification(c.proxies.v[0], PlainExtinction<ScalarLanes>(v), &c);
       return c;
     }
     if (cropKeep != kNoCropping && Cropped(world)) return c;  // (a cropped scene is not plain)
