@@ -72,17 +72,24 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
     """trame-rca's image scheduler with the render loop above. `presence`
     says whether a browser is connected; `on_frame(mappers, frames)` is
     called after each render with the frames pushed so far (the page's
-    refinement status)."""
+    refinement status); `network_completion()` gives an awaitable that
+    ends when the messages already handed to the network have been sent
+    (trame's `server.network_completion`)."""
 
     # How often the pass in flight is checked: the delay between a pass's
     # end and its frame's capture, at most.
     POLL_S = 0.01
 
-    def __init__(self, window, *, presence, on_frame=None, quality=80, **kwargs):
+    # How long a preview may take to be encoded and sent before the first
+    # full pass starts anyway.
+    PREVIEW_SEND_S = 0.25
+
+    def __init__(self, window, *, presence, on_frame=None, network_completion=None, quality=80, **kwargs):
         kwargs["interactive_quality"] = quality
         kwargs["still_quality"] = quality
         self.presence = presence
         self.on_frame = on_frame
+        self.network_completion = network_completion
         self.frames = 0
         self.stalled_at = None
         self.pushed = None  # progress() when the last frame was rendered
@@ -149,10 +156,19 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
             self.push_frame()
         finally:
             self.render_window.SetDesiredUpdateRate(still)
-        for _ in range(50):  # at most 0.25 s for its encoding and sending
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + self.PREVIEW_SEND_S
+        # Encoded (on trame-rca's thread) and handed to wslink's publish...
+        while self._last_push_time_ms == pushed and loop.time() < deadline:
             await asyncio.sleep(0.005)
-            if self._last_push_time_ms != pushed:
-                break
+        # ... and sent: publish only schedules the send, which a pass
+        # started now would hold back until the pass ends (the preview
+        # would arrive with the first pass, a second late).
+        if self.network_completion is not None and loop.time() < deadline:
+            try:
+                await asyncio.wait_for(self.network_completion(), timeout=deadline - loop.time())
+            except asyncio.TimeoutError:
+                pass
 
     async def _render(self):
         while await self._next_render():
@@ -205,7 +221,8 @@ def register_view_factories(view_manager, server, presence, on_frame):
             # for it; ours stands in for it while this view is made.
             class Scheduler(ProgressiveRenderScheduler):
                 def __init__(self, window, **kwargs):
-                    super().__init__(window, presence=presence, on_frame=on_frame, **kwargs)
+                    super().__init__(window, presence=presence, on_frame=on_frame,
+                                     network_completion=lambda: server.network_completion, **kwargs)
 
             original = rca_view_factory.RcaImageRenderScheduler
             rca_view_factory.RcaImageRenderScheduler = Scheduler
