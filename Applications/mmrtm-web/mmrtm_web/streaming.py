@@ -84,7 +84,7 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
     # full pass starts anyway.
     PREVIEW_SEND_S = 0.25
 
-    def __init__(self, window, *, presence, on_frame=None, network_completion=None, quality=80, **kwargs):
+    def __init__(self, window, *, presence, network_completion, on_frame=None, quality=80, **kwargs):
         kwargs["interactive_quality"] = quality
         kwargs["still_quality"] = quality
         self.presence = presence
@@ -164,7 +164,7 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         # ... and sent: publish only schedules the send, which a pass
         # started now would hold back until the pass ends (the preview
         # would arrive with the first pass, a second late).
-        if self.network_completion is not None and loop.time() < deadline:
+        if loop.time() < deadline:
             try:
                 await asyncio.wait_for(self.network_completion(), timeout=deadline - loop.time())
             except asyncio.TimeoutError:
