@@ -11,11 +11,12 @@
 #include "host_volume.h"
 #include "image_io.h"
 #include "mmrtm/camera.h"
+#include "TestOutputFolder.h"
 
 namespace mmrtm {
 namespace {
 
-std::string Scratch(const char* name) { return std::string(MMRTM_TEST_OUTPUT_DIR) + "/" + name; }
+std::string Scratch(const char* name) { return (TestOutputFolder() / name).string(); }
 
 CameraView LookAlongY(Projection projection) {
   CameraView c;

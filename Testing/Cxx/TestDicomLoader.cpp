@@ -19,6 +19,7 @@
 
 #include "label_alignment.h"
 #include "mmrtmVolumeLoader.h"
+#include "TestOutputFolder.h"
 
 namespace fs = std::filesystem;
 using mmrtm::HostVolume;
@@ -32,9 +33,9 @@ namespace {
 
 std::string Data(const std::string& name) { return std::string(MMRTM_SHARED_DATA_DIR) + "/" + name; }
 
-// A fresh, empty folder under the test output folder.
+// A fresh, empty folder in the test's own output folder.
 std::string ScratchFolder(const std::string& name) {
-  const fs::path dir = fs::path(MMRTM_TEST_OUTPUT_DIR) / "DicomLoader" / name;
+  const fs::path dir = TestOutputFolder() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir.string();

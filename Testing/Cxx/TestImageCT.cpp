@@ -28,6 +28,7 @@
 #include "image_io.h"
 #include "mmrtmVolumeLoader.h"
 #include "scene_json.h"
+#include "TestOutputFolder.h"
 
 namespace mmrtm {
 namespace {
@@ -116,7 +117,7 @@ std::string BaselinePath(const std::string& name) { return std::string(MMRTM_DAT
 void ExpectMatchesBaseline(const Rendered& r, const std::string& name,
                            const std::function<Rendered()>& baselineRender) {
   const std::string baseline = BaselinePath(name);
-  const std::string out = std::string(MMRTM_TEST_OUTPUT_DIR) + "/" + name + ".png";
+  const std::string out = (TestOutputFolder() / (name + ".png")).string();
   WritePNG(out, r.estimate.width, r.estimate.height, 3, r.png);
 
   // Not a black or blown-out image: the skull covers part of the frame, and

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "label_materials.h"
+#include "TestOutputFolder.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -28,11 +29,7 @@ json Classes() {
 }
 
 LabelTable Table() {
-  // A file per test: CTest runs the tests of this file as parallel
-  // processes, and one that rewrote a shared file while another read it
-  // left the reader an empty table (seen once in a -j2 run).
-  const std::string path = std::string(MMRTM_TEST_OUTPUT_DIR) + "/label_materials_table_" +
-                           ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
+  const std::string path = (TestOutputFolder() / "label_table.txt").string();
   std::ofstream(path) << "# test\n1 aorta\n2 vertebrae_T12 255 0 0\n3 liver 0 255 0 255\n";
   return ReadLabelTable(path);
 }

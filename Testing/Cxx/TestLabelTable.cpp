@@ -1,6 +1,6 @@
 // Tests of ReadLabelTable on the label tables in MMRTM_SHARED_DATA_DIR and on
 // small hand-made files (3D Slicer colour tables, non-colour extras, every
-// error) written to MMRTM_TEST_OUTPUT_DIR.
+// error) written to the test's own output folder.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <string>
 
 #include "label_table.h"
+#include "TestOutputFolder.h"
 
 namespace fs = std::filesystem;
 using namespace mmrtm;
@@ -17,9 +18,7 @@ using namespace mmrtm;
 namespace {
 
 std::string Write(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::path(MMRTM_TEST_OUTPUT_DIR) / "LabelTable";
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
+  const fs::path p = TestOutputFolder() / name;
   std::ofstream(p, std::ios::binary) << text;
   return p.string();
 }
@@ -141,7 +140,7 @@ TEST(LabelTable, ExtraTokensThatAreNotAColour) {
 }
 
 TEST(LabelTable, ErrorsNameTheFileAndLine) {
-  const std::string missing = (fs::path(MMRTM_TEST_OUTPUT_DIR) / "LabelTable" / "missing.txt").string();
+  const std::string missing = (TestOutputFolder() / "missing.txt").string();
   fs::remove(missing);
   try {
     ReadLabelTable(missing);
@@ -168,7 +167,7 @@ TEST(LabelTable, ErrorsNameTheFileAndLine) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.file);
     const std::string message = ErrorOf(c.file, c.text);
-    const std::string path = (fs::path(MMRTM_TEST_OUTPUT_DIR) / "LabelTable" / c.file).string();
+    const std::string path = (TestOutputFolder() / c.file).string();
     EXPECT_EQ(message.rfind(path + ":", 0), 0u) << message;
     EXPECT_NE(message.find(path + c.expected), std::string::npos) << message;
   }

@@ -1,5 +1,5 @@
 // Tests of mmrtm::LoadVolume (DICOM series: TestDicomLoader.cpp) on the real volumes in MMRTM_SHARED_DATA_DIR and
-// on small broken or hand-made files written to MMRTM_TEST_OUTPUT_DIR.
+// on small broken or hand-made files written to the test's own output folder.
 #include <gtest/gtest.h>
 #include <zlib.h>
 
@@ -15,6 +15,7 @@
 
 #include "label_alignment.h"
 #include "mmrtmVolumeLoader.h"
+#include "TestOutputFolder.h"
 
 namespace fs = std::filesystem;
 using mmrtm::HostVolume;
@@ -27,10 +28,9 @@ namespace {
 
 std::string Data(const std::string& name) { return std::string(MMRTM_SHARED_DATA_DIR) + "/" + name; }
 
-// A fresh path under the test output folder (any old file there is removed).
+// A fresh path in the test's own output folder (any old file there is removed).
 std::string Scratch(const std::string& name) {
-  const fs::path dir = fs::path(MMRTM_TEST_OUTPUT_DIR) / "VolumeLoader";
-  fs::create_directories(dir);
+  const fs::path dir = TestOutputFolder();
   fs::remove_all(dir / name);
   return (dir / name).string();
 }
