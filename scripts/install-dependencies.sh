@@ -34,8 +34,8 @@ fi
 
 # The accuracy checks and charts (Testing/Accuracy) run in a virtual
 # environment of Debian's Python with pinned PyPI packages: Mitsuba 3 (the
-# independent renderer), numpy and matplotlib; and the `oidn` wheel, whose
-# Open Image Denoise library the denoised preview loads. CMake finds it at .venv.
+# independent renderer), numpy and matplotlib; and the `pyoidn` wheel, whose
+# Open Image Denoise library the denoised display loads. CMake finds it at .venv.
 here="$(cd "$(dirname "$0")/.." && pwd)"
 venv="$here/.venv"
 # Reinstalled when the pins change (a dry run that needs no download says
@@ -43,7 +43,7 @@ venv="$here/.venv"
 requirements="$here/Testing/Accuracy/requirements.txt"
 if ! "$venv/bin/python" -m pip install --dry-run --no-index --disable-pip-version-check --quiet \
        -r "$requirements" >/dev/null 2>&1; then
-  echo "Setting up $venv (mitsuba, numpy, matplotlib, oidn)" >&2
+  echo "Setting up $venv (mitsuba, numpy, matplotlib, pyoidn)" >&2
   [ -x "$venv/bin/python" ] || /usr/bin/python3 -m venv "$venv"
   "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r "$requirements"
 fi

@@ -21,8 +21,8 @@
 #include <unistd.h>
 
 #include "adaptive_sampling.h"
+#include "denoised_display.h"
 #include "denoiser.h"
-#include "feature_pass.h"
 #include "image_io.h"
 #include "mmrtmVolumeLoader.h"
 #include "render_backend.h"
@@ -95,12 +95,18 @@ options:
   --output FILE.png     tone-mapped image (default: mmrtm-render.png)
   --output-linear FILE.pfm   linear radiance, float RGB
   --output-variance FILE.pfm  per-pixel variance of that mean (from the samples), float RGB
-  --denoised-preview FILE     also a denoised copy of the image (.png tone mapped, .pfm
-                        linear) by Intel Open Image Denoise: a biased preview; the
-                        outputs above stay unbiased
-  --preview-features N  guide that denoiser by the albedo and normal where camera rays
-                        first collide, N samples per pixel (default 0: colour only;
-                        16 keeps more edges, for about a third of a 16-spp render)
+  --denoise MODE        what --output shows: off (the unbiased image; default), auto
+                        (the image denoised by Intel Open Image Denoise where that is
+                        estimated closer to the truth, from the image's two halves)
+                        or always (denoised); a denoised image is biased, and
+                        --stats-json says which was written
+  --denoised-preview FILE     also the denoised image (.png tone mapped, .pfm linear),
+                        whatever --denoise shows; --output-linear and
+                        --output-variance are the unbiased image's either way
+  --output-denoiser-inputs PREFIX  the denoiser's inputs as linear PFM images:
+                        PREFIX_color_even.pfm and _odd (the means of the even and the
+                        odd samples), PREFIX_albedo.pfm and _normal.pfm (where camera
+                        rays first collide), and those of each half (_albedo_even ...)
   --stats-json FILE     timings, samples, collisions, density lookups and noise
   --quiet               no progress bars (loading, building, rendering)
   --help                this text
@@ -132,14 +138,15 @@ json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t 
 
 struct Options {
   std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear,
-                                                                outputVariance, statsJson, denoisedPreview;
+                                                                outputVariance, statsJson, denoisedPreview,
+                                                                outputDenoiserInputs;
+  mmrtm::DenoisingMode denoise = mmrtm::DenoisingMode::Off;
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
   mmrtm::SimdMode simd = mmrtm::SimdMode::Auto;
   bool quiet = false, listSeries = false;
   double noiseTarget = 0;     // 0: render all --spp samples
   bool adaptive = false;      // --sampling adaptive
-  int previewFeatureSpp = 0;  // --preview-features: first-hit feature samples per pixel, 0: none
 };
 
 [[noreturn]] void UsageError(const std::string& msg) {
@@ -245,10 +252,15 @@ Options ParseArguments(int argc, char** argv) {
       const std::string ext = LowerExtension(o.denoisedPreview);
       if (ext != ".png" && ext != ".pfm")
         UsageError("--denoised-preview expects a .png or .pfm file, got '" + o.denoisedPreview + "'");
-    } else if (a == "--preview-features")
-      o.previewFeatureSpp = (int)ParseInteger(a, value(), 0, 4096);
-    else if (a == "--output-variance")
+    } else if (a == "--denoise") {
+      const std::string m = value();
+      const auto mode = mmrtm::ParseDenoisingMode(m);
+      if (!mode) UsageError("--denoise expects off, auto or always, got '" + m + "'");
+      o.denoise = *mode;
+    } else if (a == "--output-variance")
       o.outputVariance = value();
+    else if (a == "--output-denoiser-inputs")
+      o.outputDenoiserInputs = value();
     else if (a == "--ray-march-step")
       o.render["ray_march_step"] = ParseReal(a, value());
     else if (a == "--stats-json")
@@ -417,35 +429,43 @@ bool RenderAdaptively(mmrtm::Renderer& renderer, const mmrtm::Scene& scene, cons
   return false;
 }
 
-// The denoised preview (Documentation/denoising.md): OIDN on the image's
-// colour, guided by first-hit albedo and normals of `featureSamples`
-// samples per pixel when that is above 0 (rendered on the CPU). Written
-// like the other outputs (.pfm linear, else PNG); returns what
-// --stats-json reports of it.
-json WriteDenoisedPreview(const std::string& path, const mmrtm::Denoiser& denoiser, const mmrtm::SceneView& view,
-                          const mmrtm::Film& film, const mmrtm::RenderSettings& rs, int featureSamples) {
-  const auto t0 = std::chrono::steady_clock::now();
-  mmrtm::FeatureImages features;
-  if (featureSamples > 0) features = mmrtm::RenderFeatureImages(view, featureSamples, rs.threads);
-  const double featureSeconds = SecondsSince(t0);
-  const auto t1 = std::chrono::steady_clock::now();
-  const mmrtm::RGBImage denoised = featureSamples > 0
-                                       ? denoiser.Denoise(film.Linear(), &features.albedo, &features.normal)
-                                       : denoiser.Denoise(film.Linear(), nullptr, nullptr);
-  const double denoiseSeconds = SecondsSince(t1);
-  if (LowerExtension(path) == ".pfm") {  // else .png (ParseArguments)
-    mmrtm::WritePFM(path, denoised);
-  } else {
-    std::vector<uint8_t> png((size_t)denoised.width * denoised.height * 3);
-    for (size_t i = 0; i < denoised.pixels.size(); ++i)
-      mmrtm::ToneMapPixel(denoised.pixels[i], rs.exposure, rs.toneMapper, &png[3 * i]);
-    mmrtm::WritePNG(path, denoised.width, denoised.height, 3, png);
+// The denoised image (Documentation/denoising.md): the film denoised as the
+// views' display denoises it, guided by its first-hit albedo and normal,
+// and estimated from its halves with --denoise auto. Returns what
+// --stats-json reports of it; `shown` says whether --output shows it.
+json DenoiseFilm(const Options& o, mmrtm::Denoiser& denoiser, const mmrtm::Film& film, const mmrtm::RenderSettings& rs,
+                 std::optional<mmrtm::DenoisedFilm>* denoised, bool* shown) {
+  mmrtm::DenoisedDisplay display;
+  display.SetMode(o.denoise == mmrtm::DenoisingMode::Off ? mmrtm::DenoisingMode::Always : o.denoise);
+  display.Started();
+  const mmrtm::FilmSnapshot snapshot = mmrtm::SnapshotFilm(film, 0);
+  *denoised = mmrtm::DenoiseSnapshot(snapshot, display.WantsEstimate(0, film.Samples()), true,
+                                     mmrtm::OidnDenoise(denoiser));
+  display.Finished(*denoised);
+  *shown = o.denoise != mmrtm::DenoisingMode::Off && display.Shown(0, film.Samples()) != nullptr;
+  if (!o.denoisedPreview.empty()) {
+    const mmrtm::RGBImage& image = (*denoised)->image;
+    if (LowerExtension(o.denoisedPreview) == ".pfm") {  // else .png (ParseArguments)
+      mmrtm::WritePFM(o.denoisedPreview, image);
+    } else {
+      std::vector<uint8_t> png((size_t)image.width * image.height * 3);
+      for (size_t i = 0; i < image.pixels.size(); ++i)
+        mmrtm::ToneMapPixel(image.pixels[i], rs.exposure, rs.toneMapper, &png[3 * i]);
+      mmrtm::WritePNG(o.denoisedPreview, image.width, image.height, 3, png);
+    }
   }
-  return {{"file", path},
-          {"biased", true},
+  json estimate = nullptr;
+  if (const mmrtm::DenoiseEstimate* e = display.Estimate(0))
+    estimate = {{"denoised_relative_error", std::sqrt(e->denoised) / e->meanValue},
+                {"film_relative_error", std::sqrt(e->film) / e->meanValue}};
+  return {{"mode", mmrtm::DenoisingModeName(o.denoise)},
+          {"shown", *shown},
+          {"biased", *shown},
+          {"file", o.denoisedPreview.empty() ? json(nullptr) : json(o.denoisedPreview)},
           {"denoiser", denoiser.Description()},
-          {"feature_spp", featureSamples},
-          {"seconds", {{"features", featureSeconds}, {"denoise", denoiseSeconds}}}};
+          {"guides", film.Samples() >= 2 ? "first-hit albedo and normal, denoised" : "none (one sample)"},
+          {"estimate", estimate},
+          {"seconds", display.LastSeconds()}};
 }
 
 int ListSeries(const Options& o) {
@@ -465,9 +485,10 @@ int Run(const Options& o) {
   CheckWritable(o.outputVariance);
   CheckWritable(o.statsJson);
   CheckWritable(o.denoisedPreview);
-  // Found before a long render, or the preview fails at the end.
+  // Found before a long render, or the denoising fails at the end.
   std::unique_ptr<mmrtm::Denoiser> denoiser;
-  if (!o.denoisedPreview.empty()) denoiser = mmrtm::Denoiser::Load();
+  if (!o.denoisedPreview.empty() || o.denoise != mmrtm::DenoisingMode::Off)
+    denoiser = mmrtm::Denoiser::Load(o.render.value("threads", 0));
 
   // The scene document: preset, then the scene file over it, then the options.
   json doc = json::object();
@@ -528,6 +549,7 @@ int Run(const Options& o) {
   };
   std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note, o.simd);
   mmrtm::Film film(rs.width, rs.height);
+  if (denoiser || !o.outputDenoiserInputs.empty()) film.TrackDenoiserInputs();
   mmrtm::TraceCounters counters;
   if (!o.quiet)
     std::fprintf(stderr, "%d x %d, %d spp, %s, %s, majorant %.4g /mm\n", rs.width, rs.height, rs.samplesPerPixel,
@@ -542,11 +564,32 @@ int Run(const Options& o) {
   if (reachedTarget) bar(1000, 1000);
   const double renderSeconds = bar.Seconds();
 
-  mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, film.ToneMapped(rs.exposure, rs.toneMapper));
+  json denoising = nullptr;
+  std::optional<mmrtm::DenoisedFilm> denoised;
+  bool showDenoised = false;
+  if (denoiser) denoising = DenoiseFilm(o, *denoiser, film, rs, &denoised, &showDenoised);
+  if (showDenoised) {
+    std::vector<uint8_t> png((size_t)film.Width() * film.Height() * 3);
+    for (size_t i = 0; i < denoised->image.pixels.size(); ++i)
+      mmrtm::ToneMapPixel(denoised->image.pixels[i], rs.exposure, rs.toneMapper, &png[3 * i]);
+    mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, png);
+  } else {
+    mmrtm::WritePNG(o.output, film.Width(), film.Height(), 3, film.ToneMapped(rs.exposure, rs.toneMapper));
+  }
   if (!o.outputLinear.empty()) mmrtm::WritePFM(o.outputLinear, film.Linear());
   if (!o.outputVariance.empty()) mmrtm::WritePFM(o.outputVariance, film.VarianceOfMeanImage());
-  json preview = nullptr;
-  if (denoiser) preview = WriteDenoisedPreview(o.denoisedPreview, *denoiser, view, film, rs, o.previewFeatureSpp);
+  if (!o.outputDenoiserInputs.empty()) {
+    const mmrtm::FilmHalves h = film.DenoiserImages();
+    const std::string& p = o.outputDenoiserInputs;
+    for (int half = 0; half < 2; ++half) {
+      const std::string suffix = half == 0 ? "_even" : "_odd";
+      mmrtm::WritePFM(p + "_color" + suffix + ".pfm", h.color[half]);
+      mmrtm::WritePFM(p + "_albedo" + suffix + ".pfm", h.albedo[half]);
+      mmrtm::WritePFM(p + "_normal" + suffix + ".pfm", h.normal[half]);
+    }
+    mmrtm::WritePFM(p + "_albedo.pfm", h.albedoWhole);
+    mmrtm::WritePFM(p + "_normal.pfm", h.normalWhole);
+  }
 
   const mmrtm::NoiseEstimate noise = film.Noise();
   const double samples = (double)film.Width() * film.Height() * film.MeanSamples();
@@ -556,12 +599,19 @@ int Run(const Options& o) {
                  reachedTarget ? " (noise target reached)" : "", renderSeconds, samples / renderSeconds,
                  noise.relative);
   if (denoiser && !o.quiet) {
-    char guide[96] = ", colour only";
-    if (o.previewFeatureSpp > 0)
-      std::snprintf(guide, sizeof guide, ", guided by first-hit features (%d spp, %.2f s)", o.previewFeatureSpp,
-                    preview["seconds"]["features"].get<double>());
-    std::fprintf(stderr, "Wrote %s: denoised preview (biased), %.2f s denoising%s\n", o.denoisedPreview.c_str(),
-                 preview["seconds"]["denoise"].get<double>(), guide);
+    std::string estimate;
+    if (!denoising["estimate"].is_null()) {
+      char text[128];
+      std::snprintf(text, sizeof text, "; estimated relative error %.3g denoised, %.3g unbiased",
+                    denoising["estimate"]["denoised_relative_error"].get<double>(),
+                    denoising["estimate"]["film_relative_error"].get<double>());
+      estimate = text;
+    }
+    std::fprintf(stderr, "Denoised in %.2f s%s%s%s%s\n", denoising["seconds"].get<double>(), estimate.c_str(),
+                 o.denoise == mmrtm::DenoisingMode::Off ? ""
+                 : showDenoised                         ? "; --output shows it (biased)"
+                                                        : "; --output shows the unbiased image",
+                 o.denoisedPreview.empty() ? "" : "; wrote ", o.denoisedPreview.c_str());
   }
   if (!o.statsJson.empty()) {
     json stats = {
@@ -595,7 +645,7 @@ int Run(const Options& o) {
         {"density_lookups_per_real_collision",
          counters.realCollisions ? (double)counters.densityLookups / counters.realCollisions : 0.0},
         {"memory", MemoryJson(scene, view, inputVoxelBytes)},
-        {"denoised_preview", preview},
+        {"denoising", denoising},
         {"noise",
          {{"mean_luminance", noise.meanLuminance},
           {"rms_standard_error", noise.rmsStandardError},

@@ -239,15 +239,18 @@ class RenderCli(unittest.TestCase):
         scene = self.write("scene.json", json.dumps({"render": {"sampler": "halton"}}))
         self.expect_failure(self.run_render(HEADSQ, "--preset", "ct-bone", "--scene", scene), "render.sampler", "halton")
 
-    def test_denoised_preview(self):
+    def test_denoise(self):
         # No library: an error before rendering that names what was tried; no output.
         png = os.path.join(self.dir, "preview.png")
-        r = subprocess.run([RENDER, HEADSQ, "--spp", "1", "--denoised-preview", png, "--output", self.png, "--quiet"],
-                           capture_output=True, text=True, timeout=300,
-                           env=dict(os.environ, MMRTM_OIDN_LIBRARY=os.path.join(self.dir, "libnone.so")))
-        self.expect_failure(r, "Open Image Denoise not found", "libnone.so")
-        self.assertFalse(os.path.exists(png))
-        self.expect_failure(self.run_render(HEADSQ, "--preview-features", "-1"), "--preview-features", code=2)
+        for flags in (["--denoised-preview", png], ["--denoise", "auto"]):
+            r = subprocess.run([RENDER, HEADSQ, "--spp", "1", *flags, "--output", self.png, "--quiet"],
+                               capture_output=True, text=True, timeout=300,
+                               env=dict(os.environ, MMRTM_OIDN_LIBRARY=os.path.join(self.dir, "libnone.so")))
+            self.expect_failure(r, "Open Image Denoise not found", "libnone.so")
+            self.assertFalse(os.path.exists(png))
+            self.assertFalse(os.path.exists(self.png))
+        self.expect_failure(self.run_render(HEADSQ, "--denoise", "sometimes"), "--denoise expects off, auto or always",
+                            code=2)
         self.expect_failure(self.run_render(HEADSQ, "--denoised-preview", os.path.join(self.dir, "p.exr")),
                             "--denoised-preview expects a .png or .pfm", code=2)
         if os.environ.get("MMRTM_SANITIZED"):
@@ -255,24 +258,32 @@ class RenderCli(unittest.TestCase):
                           "sanitizer runtime refuses (the Release build runs this test)")
         r = self.run_render(HEADSQ, "--width", "8", "--height", "8", "--spp", "1", "--denoised-preview", png)
         if r.returncode != 0 and "Open Image Denoise not found" in r.stderr:
-            self.skipTest("no Open Image Denoise library (scripts/install-dependencies.sh installs the oidn wheel): "
-                          + r.stderr.strip().splitlines()[-1])
+            self.skipTest("no Open Image Denoise library (scripts/install-dependencies.sh installs the pyoidn "
+                          "wheel): " + r.stderr.strip().splitlines()[-1])
         self.assertEqual(r.returncode, 0, r.stderr)
-        # A biased extra image (Documentation/denoising.md): the unbiased
-        # outputs are the same bits with it as without it.
+        # The unbiased outputs are the same bits whatever is denoised or
+        # shown (Documentation/denoising.md).
         preview = os.path.join(self.dir, "preview.pfm")
         plain, plain_pixels = self.render_linear("plain", "--spp", "4")
-        self.assertIsNone(plain["denoised_preview"])
-        stats, pixels = self.render_linear("with", "--spp", "4", "--denoised-preview", preview)
-        self.assertEqual(pixels, plain_pixels)
-        p = stats["denoised_preview"]
-        self.assertTrue(p["biased"])
-        self.assertIn("Open Image Denoise", p["denoiser"])
-        self.assertEqual(p["feature_spp"], 0)
-        # A 1-spp preview is nearer a 256-spp render (another seed) than the
-        # 1-spp image is (0.27-0.28 of its RMSE over four seeds; held to
-        # 0.4), and as bright (measured within 0.3 %; held to 3 %): not a
-        # black or blurred-away image.
+        self.assertIsNone(plain["denoising"])
+        for mode in ("off", "auto", "always"):
+            stats, pixels = self.render_linear(mode, "--spp", "4", "--denoise", mode, "--denoised-preview", preview)
+            self.assertEqual(pixels, plain_pixels, mode)
+            d = stats["denoising"]
+            self.assertIn("Open Image Denoise 2.", d["denoiser"])
+            self.assertEqual(d["mode"], mode)
+            self.assertEqual(d["shown"], mode != "off")  # 4 spp: auto finds the denoised image closer
+            self.assertEqual(d["biased"], d["shown"])
+            self.assertEqual(d["guides"], "first-hit albedo and normal, denoised")
+            if mode == "auto":
+                e = d["estimate"]
+                self.assertLess(e["denoised_relative_error"], e["film_relative_error"])
+            else:
+                self.assertIsNone(d["estimate"])
+        # A 1-spp denoised image is nearer a 256-spp render (another seed)
+        # than the 1-spp image is (0.27-0.28 of its RMSE over four seeds;
+        # held to 0.4), and as bright (measured within 0.3 %; held to 3 %):
+        # not a black or blurred-away image.
         size = ("--width", "80", "--height", "60")
         _, raw = self.render_linear("raw", *size, "--spp", "1", "--denoised-preview", preview)
         _, reference = self.render_linear("reference", *size, "--spp", "256", "--seed", "9")
@@ -282,11 +293,13 @@ class RenderCli(unittest.TestCase):
         rmse = lambda a: (sum((x - y) ** 2 for x, y in zip(a, ref)) / len(ref)) ** 0.5  # noqa: E731
         self.assertLess(rmse(denoised), 0.4 * rmse(raw), (rmse(denoised), rmse(raw)))
         self.assertAlmostEqual(sum(denoised) / sum(ref), 1.0, delta=0.03)
-        # Guided by first-hit features, and as a PNG.
-        stats, _ = self.render_linear("guided", "--spp", "4", "--denoised-preview", png, "--preview-features", "4")
-        self.assertEqual(stats["denoised_preview"]["feature_spp"], 4)
-        with open(png, "rb") as f:
-            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        # --denoise always writes the denoised image as --output.
+        shown = os.path.join(self.dir, "shown.png")
+        r = subprocess.run([RENDER, HEADSQ, *size, "--spp", "2", "--denoise", "always", "--denoised-preview", png,
+                            "--output", shown, "--quiet"], capture_output=True, text=True, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(shown, "rb") as a, open(png, "rb") as b:
+            self.assertEqual(a.read(), b.read())
 
     def test_degenerate_volumes(self):
         # One voxel, a 1 x 1 x 1000 line, a single slice: nothing to render,
@@ -419,7 +432,8 @@ class RenderCli(unittest.TestCase):
         self.assertEqual(r.returncode, 0)
         for option in ["--scene", "--preset", "--labels", "--label-table", "--series", "--list-series", "--backend", "--width", "--height", "--spp", "--seed", "--threads",
                        "--estimator", "--output", "--output-linear", "--stats-json", "--noise-target", "--sampling",
-                       "--light-sampling", "--sampler", "--denoised-preview", "--preview-features"]:
+                       "--light-sampling", "--sampler", "--denoise", "--denoised-preview",
+                       "--output-denoiser-inputs"]:
             self.assertIn(option, r.stdout)
 
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <exception>
 #include <map>
+#include <optional>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -53,6 +54,8 @@
 #include <vtk_glew.h>
 #endif
 
+#include "denoised_display.h"
+#include "denoiser.h"
 #include "derived_proxies.h"
 #include "film.h"
 #include "label_alignment.h"
@@ -212,9 +215,36 @@ struct vtkMultiMaterialVolumeMapper::Internals
     std::thread Thread;
     std::atomic<bool> Cancel{ false }, Done{ false }, Completed{ false };
     std::string Error;
+    bool Denoising = false; // a denoise of Shown, not samples
+    std::optional<mmrtm::DenoisedFilm> Denoised;
   };
   std::unique_ptr<Pass> InFlight;
   std::unique_ptr<mmrtm::Film> Shown;
+
+  // The denoised display (DenoisingMode): what the frames show of the
+  // film. FilmGeneration numbers the film's accumulations (a restart or a
+  // reset starts a new one), so that a denoise of one is never shown over
+  // another.
+  mmrtm::DenoisedDisplay Display;
+  uint64_t FilmGeneration = 0;
+  std::unique_ptr<mmrtm::Denoiser> Denoiser; // loaded at the first need
+  bool DenoiserLoadTried = false;
+  std::optional<mmrtm::DenoisedFilm> PreviewDenoised; // the interactive preview, when denoised
+  double PreviewDenoiseSeconds = 0;
+  int PreviewDenoises = 0;
+  // What the last frame drew: the mapper's film (or the copy of it that
+  // asynchronous refinement draws), a preview, or another film (combined
+  // from other processes); how many samples it had; whether denoised.
+  enum class ShownImage
+  {
+    Nothing,
+    Film,
+    Preview,
+    Other
+  } LastShown = ShownImage::Nothing;
+  uint32_t LastShownSamples = 0;
+  bool ShowedDenoised = false;
+  std::string DisplayStatus; // GetDisplayStatus's
 
   // The last display edit (exposure, tone mapping): the mapper's
   // modification time before it (as TracingMTime gave it) and after.
@@ -467,7 +497,9 @@ void vtkMultiMaterialVolumeMapper::FinishPass(bool cancel)
   in.InFlight->Thread.join();
   if (!in.InFlight->Error.empty())
     vtkErrorMacro("Render: " << in.InFlight->Error);
-  if (in.InFlight->Completed)
+  if (in.InFlight->Denoising)
+    in.Display.Finished(std::move(in.InFlight->Denoised)); // the film is untouched
+  else if (in.InFlight->Completed)
     in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
   else
     in.Film.reset(); // a partial pass: the next render restarts
@@ -503,6 +535,7 @@ void vtkMultiMaterialVolumeMapper::ResetAccumulation()
   this->FinishPass(true);
   if (this->Internal->Film)
     this->Internal->Film->Reset();
+  ++this->Internal->FilmGeneration;
 }
 
 void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
@@ -517,6 +550,17 @@ void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
   mode = std::clamp(mode, static_cast<int>(AUTOMATIC_TONE_MAPPING), static_cast<int>(FILMIC_TONE_MAPPING));
   if (mode != this->ToneMapping)
     this->DisplayEdit([&] { this->ToneMapping = mode; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
+{
+  mode = std::clamp(mode, static_cast<int>(DENOISING_OFF), static_cast<int>(DENOISING_ALWAYS));
+  if (mode == this->DenoisingMode)
+    return;
+  this->DisplayEdit([&] { this->DenoisingMode = mode; });
+  this->Internal->Display.SetMode(mode == DENOISING_AUTO ? mmrtm::DenoisingMode::Auto
+      : mode == DENOISING_ALWAYS                         ? mmrtm::DenoisingMode::Always
+                                                         : mmrtm::DenoisingMode::Off);
 }
 
 void vtkMultiMaterialVolumeMapper::SetCpuSimd(int mode)
@@ -688,6 +732,17 @@ double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
 bool vtkMultiMaterialVolumeMapper::IsConverged()
 {
   const mmrtm::Film* film = this->ImageFilm();
+  if (!this->FilmConverged())
+    return false;
+  // The image shown is final once no denoise is running or due.
+  Internals& in = *this->Internal;
+  return !(in.InFlight && in.InFlight->Denoising) &&
+    !in.Display.Due(in.FilmGeneration, film->Samples(), false);
+}
+
+bool vtkMultiMaterialVolumeMapper::FilmConverged()
+{
+  const mmrtm::Film* film = this->ImageFilm();
   if (!film)
     return false;
   const int accumulated = static_cast<int>(film->Samples());
@@ -724,6 +779,93 @@ void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
     }
   }
   image->GetPointData()->SetScalars(values);
+}
+
+const char* vtkMultiMaterialVolumeMapper::GetDisplayStatus()
+{
+  Internals& in = *this->Internal;
+  const mmrtm::Film* film = this->ImageFilm();
+  switch (in.LastShown)
+  {
+    case Internals::ShownImage::Nothing:
+      in.DisplayStatus = "nothing shown yet";
+      break;
+    case Internals::ShownImage::Preview:
+      in.DisplayStatus = in.ShowedDenoised ? "preview, denoised" : "preview";
+      break;
+    case Internals::ShownImage::Other:
+      in.DisplayStatus = "unbiased, " + std::to_string(in.LastShownSamples) + " samples (combined)";
+      break;
+    case Internals::ShownImage::Film:
+      in.DisplayStatus = in.Display.Status(in.FilmGeneration, in.LastShownSamples,
+        film && film->Samples() == in.LastShownSamples && film->Samples() >= 2 ? film->Noise().relative : 0.0);
+      break;
+  }
+  return in.DisplayStatus.c_str();
+}
+
+bool vtkMultiMaterialVolumeMapper::IsDenoisedImageShown()
+{
+  return this->Internal->ShowedDenoised;
+}
+
+void vtkMultiMaterialVolumeMapper::GetDisplayedImage(vtkImageData* image)
+{
+  // What a frame drawn now would show of the film (previews are not kept).
+  Internals& in = *this->Internal;
+  const mmrtm::Film* film = this->ImageFilm();
+  const mmrtm::DenoisedFilm* denoised =
+    film ? in.Display.Shown(in.FilmGeneration, film->Samples()) : nullptr;
+  if (!denoised)
+  {
+    this->GetAccumulatedImage(image);
+    return;
+  }
+  if (!image)
+    return;
+  image->Initialize();
+  const int width = denoised->image.width, height = denoised->image.height;
+  image->SetDimensions(width, height, 1);
+  vtkNew<vtkFloatArray> values;
+  values->SetName("DisplayedImage");
+  values->SetNumberOfComponents(4);
+  values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+    {
+      const size_t i = static_cast<size_t>(y) * width + x;
+      const mmrtm::RGB c = denoised->image.pixels[i];
+      const float rgba[4] = { c.r, c.g, c.b, denoised->alpha[i] };
+      values->SetTypedTuple(static_cast<vtkIdType>(height - 1 - y) * width + x, rgba);
+    }
+  image->GetPointData()->SetScalars(values);
+}
+
+int vtkMultiMaterialVolumeMapper::GetNumberOfDenoises()
+{
+  return this->Internal->Display.Denoises() + this->Internal->PreviewDenoises;
+}
+
+double vtkMultiMaterialVolumeMapper::GetDenoisingSeconds()
+{
+  return this->Internal->Display.Seconds() + this->Internal->PreviewDenoiseSeconds;
+}
+
+double vtkMultiMaterialVolumeMapper::GetLastDenoiseSeconds()
+{
+  return this->Internal->Display.LastSeconds();
+}
+
+double vtkMultiMaterialVolumeMapper::GetEstimatedDenoisedError()
+{
+  const mmrtm::DenoiseEstimate* e = this->Internal->Display.Estimate(this->Internal->FilmGeneration);
+  return e && e->meanValue > 0 ? std::sqrt(e->denoised) / e->meanValue : -1.0;
+}
+
+double vtkMultiMaterialVolumeMapper::GetEstimatedFilmError()
+{
+  const mmrtm::DenoiseEstimate* e = this->Internal->Display.Estimate(this->Internal->FilmGeneration);
+  return e && e->meanValue > 0 ? std::sqrt(e->film) / e->meanValue : -1.0;
 }
 
 int vtkMultiMaterialVolumeMapper::GetNumberOfSceneBuilds()
@@ -1212,6 +1354,7 @@ void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
   else
   {
     in.Film = std::make_unique<mmrtm::Film>(view.FilmWidth, view.FilmHeight);
+    in.Film->TrackDenoiserInputs();
     ++in.Restarts;
   }
   if (keepPrevious)
@@ -1220,6 +1363,7 @@ void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
     in.ParkedView = before;
   }
   in.Shown.reset(); // the image of the view before
+  ++in.FilmGeneration;
 }
 
 mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProperty* property)
@@ -1320,12 +1464,42 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   const int perRender = projecting        ? 1
     : in.Built.View.Tile && in.ParkedFilm ? std::max(this->SamplesPerRender, static_cast<int>(in.ParkedFilm->Samples()))
                                           : this->SamplesPerRender;
-  const int samples = this->IsConverged() ? 0
+  const int samples = this->FilmConverged() ? 0
     : this->MaximumSamples > 0            ? std::min(perRender, this->MaximumSamples - accumulated)
                                           : perRender;
   if (samples > 0)
     ++in.TracedPasses;
-  if (samples > 0 && this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown)
+  const bool background = this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown;
+  if (background && in.Display.Due(in.FilmGeneration, in.Shown->Samples(), samples > 0) && this->DenoiserReady())
+  {
+    // A denoise of the image shown, before more samples: on the thread of
+    // the passes, so that this render returns at once.
+    auto pass = std::make_unique<Internals::Pass>();
+    Internals::Pass* p = pass.get();
+    p->Denoising = true;
+    auto snapshot = std::make_shared<mmrtm::FilmSnapshot>(mmrtm::SnapshotFilm(*in.Shown, in.FilmGeneration));
+    const bool estimate = in.Display.WantsEstimate(in.FilmGeneration, in.Shown->Samples());
+    mmrtm::Denoiser* denoiser = in.Denoiser.get();
+    in.Display.Started();
+    if (samples > 0)
+      --in.TracedPasses; // no samples this time
+    p->Thread = std::thread(
+      [p, snapshot, estimate, denoiser]
+      {
+        try
+        {
+          p->Denoised = mmrtm::DenoiseSnapshot(*snapshot, estimate, true, mmrtm::OidnDenoise(*denoiser), &p->Cancel);
+        }
+        catch (const std::exception& e)
+        {
+          p->Error = e.what();
+        }
+        p->Done = true;
+      });
+    in.InFlight = std::move(pass);
+    return in.Shown.get();
+  }
+  if (samples > 0 && background)
   {
     // The next pass on a thread of its own, under in.Built; this render
     // draws the last finished image.
@@ -1354,7 +1528,43 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
   if (this->AsynchronousRefinement)
     in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
+  else if (in.Display.Due(in.FilmGeneration, in.Film->Samples(), !this->FilmConverged()) && this->DenoiserReady())
+  {
+    // Synchronous refinement: the denoise after the pass, in this render.
+    in.Display.Started();
+    std::optional<mmrtm::DenoisedFilm> denoised;
+    try
+    {
+      denoised = mmrtm::DenoiseSnapshot(mmrtm::SnapshotFilm(*in.Film, in.FilmGeneration),
+        in.Display.WantsEstimate(in.FilmGeneration, in.Film->Samples()), true, mmrtm::OidnDenoise(*in.Denoiser));
+    }
+    catch (const std::exception& e)
+    {
+      vtkErrorMacro("Render: the denoiser failed: " << e.what());
+    }
+    in.Display.Finished(std::move(denoised));
+  }
   return in.Film.get();
+}
+
+bool vtkMultiMaterialVolumeMapper::DenoiserReady()
+{
+  Internals& in = *this->Internal;
+  if (!in.Denoiser && !in.DenoiserLoadTried)
+  {
+    in.DenoiserLoadTried = true;
+    try
+    {
+      in.Denoiser = mmrtm::Denoiser::Load(this->NumberOfThreads);
+    }
+    catch (const mmrtm::DenoiserError& e)
+    {
+      // Said once; the status names it while a denoising mode is on.
+      in.Display.SetUnavailable("Intel Open Image Denoise not found");
+      vtkWarningMacro(<< e.what());
+    }
+  }
+  return in.Denoiser != nullptr;
 }
 
 // The proxies of the input (its components as the property uses them), the
@@ -1609,9 +1819,31 @@ double vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, 
   const auto start = std::chrono::steady_clock::now();
   in.Renderer->Render(in.Scene, view, *in.Preview, 1, nullptr, nullptr);
   ++in.TracedPasses;
+  // Denoised on its colour alone, at OIDN's fast quality: one sample's
+  // guides are as noisy as its colour, and the frame has a budget.
+  in.PreviewDenoised.reset();
+  if (this->DenoisingMode != DENOISING_OFF && this->DenoiserReady())
+  {
+    const auto denoiseStart = std::chrono::steady_clock::now();
+    in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Fast);
+    try
+    {
+      in.PreviewDenoised = mmrtm::DenoiseSnapshot(
+        mmrtm::SnapshotFilm(*in.Preview, 0), false, false, mmrtm::OidnDenoise(*in.Denoiser));
+    }
+    catch (const mmrtm::DenoiserError& e)
+    {
+      vtkErrorMacro("Render: the denoiser failed: " << e.what());
+    }
+    in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Balanced);
+    in.PreviewDenoiseSeconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - denoiseStart).count();
+    ++in.PreviewDenoises;
+  }
   // The still render after the interaction starts again at full resolution.
   in.Film.reset();
   ++in.InteractiveRenders;
+  // The denoise scales with the pixels as the tracing does (AdaptPreview).
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -1645,7 +1877,42 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
     : this->ToneMapping == FILMIC_TONE_MAPPING                   ? mmrtm::ToneMapper::Filmic
     : this->ToneMapping == AUTOMATIC_TONE_MAPPING && description ? rs.toneMapper // the description's
                                                                  : mmrtm::ToneMapper::Off;
+  // What the display shows of the film (DenoisingMode): the mapper's own
+  // film or preview (a film combined from other processes has no denoiser
+  // inputs: it is shown as it is).
+  Internals& in = *this->Internal;
+  const mmrtm::RGBImage* denoised = nullptr;
+  const std::vector<float>* denoisedAlpha = nullptr;
+  in.LastShown = Internals::ShownImage::Other;
+  if (&film == in.Preview.get())
+  {
+    if (in.PreviewDenoised)
+    {
+      denoised = &in.PreviewDenoised->image;
+      denoisedAlpha = &in.PreviewDenoised->alpha;
+    }
+    in.LastShown = Internals::ShownImage::Preview;
+  }
+  else if (&film == this->ImageFilm())
+  {
+    if (const mmrtm::DenoisedFilm* shown = in.Display.Shown(in.FilmGeneration, film.Samples()))
+    {
+      denoised = &shown->image;
+      denoisedAlpha = &shown->alpha;
+    }
+    in.LastShown = Internals::ShownImage::Film;
+  }
+  in.LastShownSamples = film.Samples();
+  in.ShowedDenoised = denoised != nullptr;
   std::vector<uint8_t> rgba = film.ToneMapped(static_cast<float>(this->Exposure), toneMapper, 4);
+  if (denoised)
+    for (size_t i = 0; i < denoised->pixels.size(); ++i)
+    {
+      uint8_t* p = &rgba[4 * i];
+      mmrtm::ToneMapPixel(denoised->pixels[i], static_cast<float>(this->Exposure), toneMapper, p);
+      if (denoisedAlpha)
+        p[3] = static_cast<uint8_t>(mmrtm::Clamp((*denoisedAlpha)[i], 0.f, 1.f) * 255.f + 0.5f);
+    }
   const size_t row = 4 * static_cast<size_t>(width);
   for (int y = 0; y < height / 2; ++y)
     std::swap_ranges(rgba.begin() + y * row, rgba.begin() + (y + 1) * row, rgba.begin() + (height - 1 - y) * row);

@@ -218,8 +218,8 @@ public:
    * application's event loop stays responsive. A render that finds
    * anything changed stops the pass in flight (between 16 x 16 tiles) and
    * restarts. The images are the same as without it (one seed, one sample
-   * count). IsRefining() says whether a pass is in flight: an application
-   * renders again a little later to pick up its samples.
+   * count). IsRefining() says whether a pass (or a denoise) is in flight:
+   * an application renders again a little later to pick up its samples.
    */
   vtkSetMacro(AsynchronousRefinement, vtkTypeBool);
   vtkGetMacro(AsynchronousRefinement, vtkTypeBool);
@@ -396,6 +396,68 @@ public:
   vtkGetMacro(EnvironmentIntensity, double);
   ///@}
 
+  enum DenoisingModes
+  {
+    DENOISING_OFF = 0,
+    DENOISING_AUTO = 1,
+    DENOISING_ALWAYS = 2
+  };
+  ///@{
+  /**
+   * What the view shows of the accumulation (Documentation/denoising.md).
+   * OFF (the default, so that regression images stay unbiased): the
+   * accumulated film. AUTO: the film denoised by Intel Open Image Denoise
+   * while that is estimated closer to the truth than the film (from the
+   * film's two independent halves), then the film. ALWAYS: the denoised
+   * film. Either way the accumulation goes on underneath, the same to the
+   * bit, and a change of mode keeps it. The denoiser is guided by the
+   * albedo and normal where the camera rays first collide, gathered with
+   * the samples; it runs after a pass, at most a quarter of the time, on
+   * the refinement thread with AsynchronousRefinement. Interactive
+   * previews are denoised too (colour only). Without the library the film
+   * is shown and GetDisplayStatus says why.
+   */
+  virtual void SetDenoisingMode(int mode);
+  vtkGetMacro(DenoisingMode, int);
+  void SetDenoisingModeToOff() { this->SetDenoisingMode(DENOISING_OFF); }
+  void SetDenoisingModeToAuto() { this->SetDenoisingMode(DENOISING_AUTO); }
+  void SetDenoisingModeToAlways() { this->SetDenoisingMode(DENOISING_ALWAYS); }
+  ///@}
+
+  /**
+   * What the last frame showed: "denoised, 8 samples", "unbiased, 64
+   * samples, noise 2.1 %", "preview, denoised", with the reason where a
+   * denoising mode could not denoise ("not denoised: ...").
+   */
+  const char* GetDisplayStatus();
+
+  /**
+   * Whether the last frame drawn showed a denoised image.
+   */
+  bool IsDenoisedImageShown();
+
+  /**
+   * The image the last frame showed (the denoised one, or the accumulated
+   * film's), linear RGB and alpha as GetAccumulatedImage gives the film's;
+   * emptied when nothing was shown.
+   */
+  void GetDisplayedImage(vtkImageData* image);
+
+  ///@{
+  /**
+   * The denoised display's costs and estimates: denoiser runs and their
+   * seconds since construction (previews included), and, for the
+   * accumulation shown, Auto's latest estimates of the relative RMS error
+   * of the denoised image and of the film when they were made (-1 when
+   * none was made).
+   */
+  int GetNumberOfDenoises();
+  double GetDenoisingSeconds();
+  double GetLastDenoiseSeconds();
+  double GetEstimatedDenoisedError();
+  double GetEstimatedFilmError();
+  ///@}
+
   ///@{
   /**
    * While the render window asks for an interactive frame rate (its
@@ -477,9 +539,10 @@ public:
   double GetRelativeNoise();
 
   /**
-   * Whether the accumulation has reached MaximumSamples or NoiseTarget, so
-   * that Render() only redraws: an application refining while idle stops
-   * asking for renders then.
+   * Whether the accumulation has reached MaximumSamples or NoiseTarget and
+   * the image shown is final (no denoise is due or running), so that
+   * Render() only redraws: an application refining while idle stops asking
+   * for renders then.
    */
   bool IsConverged();
 
@@ -580,6 +643,7 @@ protected:
   vtkTypeBool AutoAdjustSampleDistances = 1;
   float SampleDistance = 1.0f;
   double EnvironmentIntensity = 1.0;
+  int DenoisingMode = DENOISING_OFF;
 
   /**
    * Draws a film into the viewport (tone-mapped, premultiplied). Render()
@@ -616,6 +680,8 @@ private:
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();
   void FinishPass(bool cancel);
+  bool FilmConverged(); // the accumulation has reached MaximumSamples or NoiseTarget
+  bool DenoiserReady();  // loads it at the first call
   bool InputWillExecute();
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();

@@ -84,6 +84,7 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   SceneView s = scene;
   s.camera.width = width;
   s.camera.height = height;
+  s.settings.firstHitGuides = view.denoiserInputs != nullptr;
 
   std::atomic<int> nextTile{0};
   std::mutex progressMutex;
@@ -117,6 +118,7 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
             for (uint32_t index = first; index < last; ++index) {
               PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
               view.AddSample(x, y, ps.L, ps.alpha, index + 1);
+              view.AddDenoiserInputs(x, y, ps.L, ps.albedo, ps.normal, index + 1);
             }
             view.AddWork(x, y, (float)(ctr.Work() - workBefore));
           }

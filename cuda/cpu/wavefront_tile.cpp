@@ -36,6 +36,7 @@ void WavefrontTile::Finish(const SceneView& s, const FilmView& view, TraceCounte
     const PixelSample ps =
         Li(s, path.sample.ray, path.sample.rng, ctr, path.sample.tMax, path.sample.Pairs(), &path.freePath);
     view.AddSample(o.x, o.y, ps.L, ps.alpha, o.index + 1);
+    view.AddDenoiserInputs(o.x, o.y, ps.L, ps.albedo, ps.normal, o.index + 1);
     work_[inTile_[i]] += path.ctr.Work() + (ctr.Work() - before);
   }
   samples_.clear();

@@ -34,6 +34,7 @@ __global__ void RenderSampleKernel(SceneView scene, FilmView film, uint32_t inde
                              ? ProjectPixel(scene, x, y, ctr)
                              : RenderPixelSample(scene, x, y, index, ctr);
   film.AddSample(x, y, ps.L, ps.alpha, index + 1);
+  film.AddDenoiserInputs(x, y, ps.L, ps.albedo, ps.normal, index + 1);
   film.AddWork(x, y, (float)ctr.Work());
   auto add = [](uint64_t* total, uint64_t v) {
     if (v) atomicAdd(reinterpret_cast<unsigned long long*>(total), (unsigned long long)v);
@@ -89,14 +90,15 @@ struct GpuRenderer::Impl {
   size_t majorantCount = 0;
   DeviceBuffer summaries[kMaxProxies], leafSummaryIds, summaryBounds, summaryLowerBounds, binMax, binMaterials, binMin,
       uncoveredBins;
-  DeviceBuffer filmMean, filmM2, filmEven, filmWork, counters, rangeFirst, rangeEnd;
+  DeviceBuffer filmMean, filmM2, filmEven, filmWork, filmDenoiserInputs, counters, rangeFirst, rangeEnd;
   int filmWidth = 0, filmHeight = 0;
   uint32_t filmSamples = 0;
   bool filmUniform = true;  // false after RenderTo: the next Render uploads the film
   bool hasWork = false;     // the device film has per-pixel work (Film::TrackWork)
+  bool hasDenoiserInputs = false;  // and the denoiser's inputs (Film::TrackDenoiserInputs)
 
   // Puts the host film on the device (mean, M2, the even samples' mean
-  // luminance, and work when tracked).
+  // luminance, and work and the denoiser's inputs when tracked).
   void UploadFilm(const FilmView& host) {
     const size_t pixels = (size_t)host.width * host.height;
     filmMean.Allocate(pixels * 4 * sizeof(float), "the film");
@@ -111,6 +113,13 @@ struct GpuRenderer::Impl {
       filmWork.Upload(host.work, pixels * sizeof(float));
     }
     hasWork = host.work != nullptr;
+    const size_t inputs = pixels * FilmView::kDenoiserInputFloats * sizeof(float);
+    filmDenoiserInputs = DeviceBuffer();
+    if (host.denoiserInputs) {
+      filmDenoiserInputs.Allocate(inputs, "the film");
+      filmDenoiserInputs.Upload(host.denoiserInputs, inputs);
+    }
+    hasDenoiserInputs = host.denoiserInputs != nullptr;
     filmWidth = host.width;
     filmHeight = host.height;
   }
@@ -120,7 +129,8 @@ struct GpuRenderer::Impl {
                     filmMean.As<float>(),
                     filmM2.As<float>(),
                     hasWork ? filmWork.As<float>() : nullptr,
-                    filmEven.As<float>()};
+                    filmEven.As<float>(),
+                    hasDenoiserInputs ? filmDenoiserInputs.As<float>() : nullptr};
   }
   void DownloadFilm(const FilmView& host) const {
     const size_t pixels = (size_t)host.width * host.height;
@@ -128,6 +138,8 @@ struct GpuRenderer::Impl {
     filmM2.Download(host.m2, pixels * 3 * sizeof(float));
     filmEven.Download(host.evenLuminance, pixels * sizeof(float));
     if (host.work) filmWork.Download(host.work, pixels * sizeof(float));
+    if (host.denoiserInputs)
+      filmDenoiserInputs.Download(host.denoiserInputs, pixels * FilmView::kDenoiserInputFloats * sizeof(float));
   }
 
   // Renders sample indices [from, to) of every pixel, or with per-pixel
@@ -139,6 +151,7 @@ struct GpuRenderer::Impl {
     SceneView scene = device;
     scene.camera.width = filmWidth;
     scene.camera.height = filmHeight;
+    scene.settings.firstHitGuides = hasDenoiserInputs;
     const FilmView film = DeviceFilm();
     MMRTM_CUDA_CHECK(cudaMemset(counters.Get(), 0, sizeof(TraceCounters)));
     const dim3 block(kBlockX, kBlockY), grid((filmWidth + kBlockX - 1) / kBlockX, (filmHeight + kBlockY - 1) / kBlockY);
@@ -316,7 +329,7 @@ void GpuRenderer::Render(Film& film, int samplesPerPixel, TraceCounters* counter
   // resize (or the first time) the host's state goes up.
   if (film.Adaptive()) throw CudaError("GpuRenderer::Render: the film has per-pixel counts (use RenderTo)");
   if (width != m.filmWidth || height != m.filmHeight || film.Samples() != m.filmSamples || !m.filmUniform ||
-      (host.work != nullptr) != m.hasWork) {
+      (host.work != nullptr) != m.hasWork || (host.denoiserInputs != nullptr) != m.hasDenoiserInputs) {
     m.UploadFilm(host);
     m.filmSamples = film.Samples();
     m.filmUniform = true;

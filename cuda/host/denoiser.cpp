@@ -25,6 +25,8 @@ struct Denoiser::Api {
   void (*setSharedFilterImage)(void* filter, const char* name, void* ptr, int format, size_t width, size_t height,
                                size_t byteOffset, size_t bytePixelStride, size_t byteRowStride) = nullptr;
   void (*setFilterBool)(void* filter, const char* name, bool value) = nullptr;
+  void (*setFilterInt)(void* filter, const char* name, int value) = nullptr;
+  void (*setFilterProgressMonitor)(void* filter, bool (*monitor)(void* user, double n), void* user) = nullptr;
   void (*commitFilter)(void* filter) = nullptr;
   void (*executeFilter)(void* filter) = nullptr;
   void (*releaseFilter)(void* filter) = nullptr;
@@ -34,6 +36,15 @@ namespace {
 
 constexpr int kDeviceTypeCpu = 1;  // OIDN_DEVICE_TYPE_CPU
 constexpr int kFormatFloat3 = 3;   // OIDN_FORMAT_FLOAT3
+constexpr int kErrorCancelled = 5;  // OIDN_ERROR_CANCELLED
+// OIDN_QUALITY_HIGH, _BALANCED, _FAST (2.x).
+constexpr int kQuality[] = {6, 5, 4};
+
+// A filter's inputs, as FilterKey's bits.
+constexpr int kColor = 1, kAlbedo = 2, kNormal = 4, kCleanGuides = 8;
+
+// The progress monitor's answer: go on while the flag is not set.
+bool GoOn(void* cancel, double) { return !(cancel && static_cast<const std::atomic<bool>*>(cancel)->load()); }
 
 // The places to look, in order (denoiser.h).
 std::vector<std::string> CandidatePaths() {
@@ -101,6 +112,8 @@ std::unique_ptr<Denoiser> Denoiser::Load(int threads) {
   Bind(a.library, "oidnNewFilter", &a.newFilter, path);
   Bind(a.library, "oidnSetSharedFilterImage", &a.setSharedFilterImage, path);
   Bind(a.library, "oidnSetFilterBool", &a.setFilterBool, path, "oidnSetFilter1b");
+  Bind(a.library, "oidnSetFilterInt", &a.setFilterInt, path, "oidnSetFilter1i");
+  Bind(a.library, "oidnSetFilterProgressMonitorFunction", &a.setFilterProgressMonitor, path);
   Bind(a.library, "oidnCommitFilter", &a.commitFilter, path);
   Bind(a.library, "oidnExecuteFilter", &a.executeFilter, path);
   Bind(a.library, "oidnReleaseFilter", &a.releaseFilter, path);
@@ -120,7 +133,10 @@ std::unique_ptr<Denoiser> Denoiser::Load(int threads) {
 }
 
 Denoiser::~Denoiser() {
-  if (api_ && device_) api_->releaseDevice(device_);
+  if (api_) {
+    for (const auto& [key, filter] : filters_) api_->releaseFilter(filter);
+    if (device_) api_->releaseDevice(device_);
+  }
   // The library stays loaded: OIDN's threads may outlive the device briefly.
 }
 
@@ -129,31 +145,54 @@ std::string Denoiser::Description() const {
          "." + std::to_string(version_ % 100) + " (" + path_ + ")";
 }
 
-RGBImage Denoiser::Denoise(const RGBImage& color, const RGBImage* albedo, const RGBImage* normal) const {
+void* Denoiser::Filter(const FilterKey& key) {
+  if (void*& filter = filters_[key]) return filter;
   const Api& a = *api_;
-  const auto sameSize = [&](const RGBImage* image) {
-    return !image || (image->width == color.width && image->height == color.height);
-  };
-  if (!sameSize(albedo) || !sameSize(normal))
-    throw DenoiserError("the albedo or normal image is not the colour's size");
-  RGBImage out{color.width, color.height, std::vector<RGB>(color.pixels.size())};
-  const auto share = [&](void* filter, const char* name, const RGBImage& image) {
-    a.setSharedFilterImage(filter, name, const_cast<RGB*>(image.pixels.data()), kFormatFloat3, (size_t)image.width,
-                           (size_t)image.height, 0, 0, 0);
-  };
   void* filter = a.newFilter(device_, "RT");
-  share(filter, "color", color);
-  if (albedo) share(filter, "albedo", *albedo);
-  if (albedo && normal) share(filter, "normal", *normal);  // OIDN takes a normal only with an albedo
-  share(filter, "output", out);
-  a.setFilterBool(filter, "hdr", true);
+  const int inputs = std::get<0>(key);
+  if (inputs & kColor) a.setFilterBool(filter, "hdr", true);
+  if (inputs & kCleanGuides) a.setFilterBool(filter, "cleanAux", true);
+  if (version_ >= 20000) a.setFilterInt(filter, "quality", std::get<3>(key));
+  return filters_[key] = filter;
+}
+
+RGBImage Denoiser::Execute(void* filter, const std::map<const char*, const RGBImage*>& inputs, int width, int height,
+                           const std::atomic<bool>* cancel) {
+  const Api& a = *api_;
+  RGBImage out{width, height, std::vector<RGB>((size_t)width * height)};
+  const auto share = [&](const char* name, const RGBImage& image) {
+    if (image.width != width || image.height != height)
+      throw DenoiserError(std::string("the ") + name + " image is not the colour's size");
+    a.setSharedFilterImage(filter, name, const_cast<RGB*>(image.pixels.data()), kFormatFloat3, (size_t)width,
+                           (size_t)height, 0, 0, 0);
+  };
+  for (const auto& [name, image] : inputs) share(name, *image);
+  share("output", out);
+  a.setFilterProgressMonitor(filter, GoOn, const_cast<std::atomic<bool>*>(cancel));
   a.commitFilter(filter);
   a.executeFilter(filter);
-  a.releaseFilter(filter);
   const char* message = nullptr;
-  if (a.getDeviceError(device_, &message) != 0)
-    throw DenoiserError(path_ + ": " + (message ? message : "the filter failed"));
+  const int error = a.getDeviceError(device_, &message);
+  if (error == kErrorCancelled || (cancel && cancel->load())) return RGBImage{};
+  if (error != 0) throw DenoiserError(path_ + ": " + (message ? message : "the filter failed"));
   return out;
+}
+
+RGBImage Denoiser::Denoise(const RGBImage& color, const RGBImage* albedo, const RGBImage* normal, bool cleanGuides,
+                           const std::atomic<bool>* cancel) {
+  if (!albedo) normal = nullptr;  // OIDN takes a normal only with an albedo
+  const int inputs = kColor | (albedo ? kAlbedo : 0) | (normal ? kNormal : 0) | (albedo && cleanGuides ? kCleanGuides : 0);
+  std::map<const char*, const RGBImage*> images{{"color", &color}};
+  if (albedo) images["albedo"] = albedo;
+  if (normal) images["normal"] = normal;
+  return Execute(Filter({inputs, color.width, color.height, kQuality[(int)quality_]}), images, color.width,
+                 color.height, cancel);
+}
+
+RGBImage Denoiser::DenoiseGuide(const RGBImage& guide, Guide which, const std::atomic<bool>* cancel) {
+  const bool isAlbedo = which == Guide::Albedo;
+  return Execute(Filter({isAlbedo ? kAlbedo : kNormal, guide.width, guide.height, kQuality[(int)quality_]}),
+                 {{isAlbedo ? "albedo" : "normal", &guide}}, guide.width, guide.height, cancel);
 }
 
 }  // namespace mmrtm

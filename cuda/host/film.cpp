@@ -19,6 +19,7 @@ void Film::Reset() {
   m2_.assign((size_t)width_ * height_ * 3, 0.f);
   evenLuminance_.assign((size_t)width_ * height_, 0.f);
   if (!work_.empty()) TrackWork();
+  if (!denoiserInputs_.empty()) TrackDenoiserInputs();
 }
 
 void Film::AddSamples(uint32_t n) {
@@ -122,6 +123,40 @@ Film Film::FromMoments(int width, int height, uint32_t samples, const std::vecto
     film.evenLuminance_[i] = m[7] > 0 ? (float)(m[8] / m[7]) : 0.f;
   }
   return film;
+}
+
+FilmHalves Film::DenoiserImages() const {
+  if (!TracksDenoiserInputs()) throw std::logic_error("Film::DenoiserImages: the film keeps no denoiser inputs");
+  FilmHalves h;
+  const size_t pixels = (size_t)width_ * height_;
+  const RGBImage blank{width_, height_, std::vector<RGB>(pixels)};
+  for (RGBImage* image : {&h.color[0], &h.color[1], &h.albedo[0], &h.albedo[1], &h.normal[0], &h.normal[1],
+                          &h.albedoWhole, &h.normalWhole})
+    *image = blank;
+  for (size_t i = 0; i < pixels; ++i) {
+    const uint32_t n = PixelSamples((int)(i % width_), (int)(i / width_)), n0 = EvenSamples(n), n1 = n - n0;
+    if (n0 == 0 || n1 == 0)
+      throw std::logic_error("Film::DenoiserImages: a pixel has " + std::to_string(n) + " sample(s); halves need 2");
+    const float* d = &denoiserInputs_[i * FilmView::kDenoiserInputFloats];
+    const float* whole = &mean_[4 * i];
+    // The odd samples' mean, from the whole's and the even ones': (n m - n0 m0) / n1.
+    const auto odd = [&](float all, float even) { return ((float)n * all - (float)n0 * even) / (float)n1; };
+    for (int c = 0; c < 3; ++c) {
+      h.color[0].pixels[i][c] = d[FilmView::kEvenRGB + c];
+      h.color[1].pixels[i][c] = odd(whole[c], d[FilmView::kEvenRGB + c]);
+      h.albedoWhole.pixels[i][c] = d[FilmView::kAlbedo + c];
+      h.normalWhole.pixels[i][c] = d[FilmView::kNormal + c];
+      h.albedo[0].pixels[i][c] = d[FilmView::kEvenAlbedo + c];
+      h.normal[0].pixels[i][c] = d[FilmView::kEvenNormal + c];
+      h.albedo[1].pixels[i][c] = odd(d[FilmView::kAlbedo + c], d[FilmView::kEvenAlbedo + c]);
+      h.normal[1].pixels[i][c] = odd(d[FilmView::kNormal + c], d[FilmView::kEvenNormal + c]);
+    }
+    if (i == 0) {
+      h.samples[0] = n0;
+      h.samples[1] = n1;
+    }
+  }
+  return h;
 }
 
 RGBImage Film::Linear() const {

@@ -21,6 +21,16 @@ struct NoiseEstimate {
 
 class Film;
 
+// What a denoised display is made from (Film::DenoiserImages): the film's
+// two halves, its even and its odd samples (independent estimates of the
+// image: two independently scrambled nets, or independent numbers), each
+// with the guides of its own samples, and the guides of all samples.
+struct FilmHalves {
+  uint32_t samples[2] = {0, 0};  // of the film's first pixel
+  RGBImage color[2], albedo[2], normal[2];
+  RGBImage albedoWhole, normalWhole;
+};
+
 // Agreement of two renders of the same scene within their noise: the mean
 // over pixels and channels of z^2 = (a - b)^2 / (var_a + var_b), skipping
 // pixels without variance (e.g. the background). About 1 when the two
@@ -32,8 +42,13 @@ class Film {
   Film(int width, int height);
 
   FilmView View() {
-    return FilmView{
-        width_, height_, mean_.data(), m2_.data(), work_.empty() ? nullptr : work_.data(), evenLuminance_.data()};
+    return FilmView{width_,
+                    height_,
+                    mean_.data(),
+                    m2_.data(),
+                    work_.empty() ? nullptr : work_.data(),
+                    evenLuminance_.data(),
+                    denoiserInputs_.empty() ? nullptr : denoiserInputs_.data()};
   }
   void Reset();
   int Width() const { return width_; }
@@ -59,6 +74,18 @@ class Film {
   void TrackWork() { work_.assign((size_t)width_ * height_, 0.f); }
   bool TracksWork() const { return !work_.empty(); }
   float Work(int x, int y) const { return work_.empty() ? 0.f : work_[(size_t)y * width_ + x]; }
+
+  // The denoised display's inputs (FilmView::denoiserInputs), kept when
+  // enabled: the renderers then ask the integrator for its first-hit guides
+  // (IntegratorSettings::firstHitGuides). The radiance's buffers are the
+  // same to the bit either way.
+  void TrackDenoiserInputs() {
+    denoiserInputs_.assign((size_t)width_ * height_ * FilmView::kDenoiserInputFloats, 0.f);
+  }
+  bool TracksDenoiserInputs() const { return !denoiserInputs_.empty(); }
+  // The halves and guides (std::logic_error without TrackDenoiserInputs or
+  // with fewer than 2 samples in a pixel).
+  FilmHalves DenoiserImages() const;
 
   RGB Mean(int x, int y) const;
   float Alpha(int x, int y) const { return mean_[4 * ((size_t)y * width_ + x) + 3]; }
@@ -100,7 +127,7 @@ class Film {
   int width_, height_;
   uint32_t samples_ = 0;
   std::vector<uint32_t> pixelSamples_;  // empty: every pixel has samples_
-  std::vector<float> mean_, m2_, work_, evenLuminance_;
+  std::vector<float> mean_, m2_, work_, evenLuminance_, denoiserInputs_;
   // A film combined by FromMoments: the even samples of every pixel (the
   // parts' (n + 1) / 2 summed, more than half of the whole where parts had
   // odd counts); 0 for a rendered film, whose n samples hold (n + 1) / 2.

@@ -116,6 +116,17 @@ void vtkSlicerMultiMaterialVolumeRenderingLogic::ApplyRenderSettings(
     default:
       mapper->SetAccelerator(vtkMultiMaterialVolumeMapper::OCTREE);
   }
+  switch (node->GetDenoisingMode())
+  {
+    case vtkMRMLMultiMaterialVolumeRenderingDisplayNode::DenoisingOff:
+      mapper->SetDenoisingModeToOff();
+      break;
+    case vtkMRMLMultiMaterialVolumeRenderingDisplayNode::DenoisingAlways:
+      mapper->SetDenoisingModeToAlways();
+      break;
+    default:
+      mapper->SetDenoisingModeToAuto();
+  }
   switch (node->GetBackend())
   {
     case vtkMRMLMultiMaterialVolumeRenderingDisplayNode::CPU:

@@ -60,6 +60,7 @@ namespace
 {
 const char* const AcceleratorNames[] = { "octree", "macrocell", "none" };
 const char* const BackendNames[] = { "auto", "cpu", "cuda" };
+const char* const DenoisingModeNames[] = { "off", "auto", "always" };
 
 // Percent-encoding of everything but letters, digits, '_', '.' and '-':
 // safe inside an XML attribute and for the separators below.
@@ -154,6 +155,21 @@ int vtkMRMLMultiMaterialVolumeRenderingDisplayNode::GetAcceleratorFromString(con
   for (int i = 0; name && i < Accelerator_Last; ++i)
   {
     if (std::strcmp(name, AcceleratorNames[i]) == 0)
+      return i;
+  }
+  return -1;
+}
+
+const char* vtkMRMLMultiMaterialVolumeRenderingDisplayNode::GetDenoisingModeAsString(int id)
+{
+  return id >= 0 && id < DenoisingMode_Last ? DenoisingModeNames[id] : "";
+}
+
+int vtkMRMLMultiMaterialVolumeRenderingDisplayNode::GetDenoisingModeFromString(const char* name)
+{
+  for (int i = 0; name && i < DenoisingMode_Last; ++i)
+  {
+    if (std::strcmp(name, DenoisingModeNames[i]) == 0)
       return i;
   }
   return -1;
@@ -254,6 +270,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::WriteXML(ostream& of, int n
   vtkMRMLWriteXMLFloatMacro(shadowExtinctionScale, ShadowExtinctionScale);
   vtkMRMLWriteXMLEnumMacro(accelerator, Accelerator);
   vtkMRMLWriteXMLEnumMacro(backend, Backend);
+  vtkMRMLWriteXMLEnumMacro(denoisingMode, DenoisingMode);
   vtkMRMLWriteXMLIntMacro(seed, Seed);
   vtkMRMLWriteXMLStringMacro(materialPreset, MaterialPreset);
   vtkMRMLWriteXMLStringMacro(sceneJSON, SceneJSON);
@@ -274,6 +291,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::ReadXMLAttributes(const cha
   vtkMRMLReadXMLFloatMacro(shadowExtinctionScale, ShadowExtinctionScale);
   vtkMRMLReadXMLEnumMacro(accelerator, Accelerator);
   vtkMRMLReadXMLEnumMacro(backend, Backend);
+  vtkMRMLReadXMLEnumMacro(denoisingMode, DenoisingMode);
   vtkMRMLReadXMLIntMacro(seed, Seed);
   vtkMRMLReadXMLStringMacro(materialPreset, MaterialPreset);
   vtkMRMLReadXMLStringMacro(sceneJSON, SceneJSON);
@@ -310,6 +328,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::CopyContent(vtkMRMLNode* an
     vtkMRMLCopyFloatMacro(ShadowExtinctionScale);
     vtkMRMLCopyEnumMacro(Accelerator);
     vtkMRMLCopyEnumMacro(Backend);
+    vtkMRMLCopyEnumMacro(DenoisingMode);
     vtkMRMLCopyIntMacro(Seed);
     vtkMRMLCopyStringMacro(MaterialPreset);
     vtkMRMLCopyStringMacro(SceneJSON);
@@ -335,6 +354,7 @@ void vtkMRMLMultiMaterialVolumeRenderingDisplayNode::PrintSelf(ostream& os, vtkI
   vtkMRMLPrintFloatMacro(ShadowExtinctionScale);
   vtkMRMLPrintEnumMacro(Accelerator);
   vtkMRMLPrintEnumMacro(Backend);
+  vtkMRMLPrintEnumMacro(DenoisingMode);
   vtkMRMLPrintIntMacro(Seed);
   vtkMRMLPrintStringMacro(MaterialPreset);
   vtkMRMLPrintStringMacro(SceneJSON);

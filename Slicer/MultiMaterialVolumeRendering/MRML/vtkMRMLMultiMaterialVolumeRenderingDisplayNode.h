@@ -129,6 +129,25 @@ public:
   static int GetBackendFromString(const char* name);
   ///@}
 
+  enum DenoisingModes
+  {
+    DenoisingOff = 0,
+    DenoisingAuto,
+    DenoisingAlways,
+    DenoisingMode_Last
+  };
+  ///@{
+  /// What the 3D view shows (vtkMultiMaterialVolumeMapper::DenoisingMode;
+  /// default Auto): the image denoised while that is estimated closer to
+  /// the truth, and noise-free previews while the view is dragged (Auto),
+  /// always denoised (Always), or the unbiased accumulation (Off). The
+  /// accumulation is the same either way, and a change keeps it.
+  vtkSetClampMacro(DenoisingMode, int, DenoisingOff, DenoisingMode_Last - 1);
+  vtkGetMacro(DenoisingMode, int);
+  static const char* GetDenoisingModeAsString(int id);
+  static int GetDenoisingModeFromString(const char* name);
+  ///@}
+
   ///@{
   /// Seed of the random numbers (default 0): one seed and sample count
   /// give one image.
@@ -193,6 +212,7 @@ protected:
   double ShadowExtinctionScale = 0.8;
   int Accelerator = Octree;
   int Backend = Auto;
+  int DenoisingMode = DenoisingAuto;
   int Seed = 0;
   std::string MaterialPreset;
   std::string SceneJSON;

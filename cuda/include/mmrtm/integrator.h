@@ -93,7 +93,13 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
       if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
         if (depth == 0) {
-          if (s.settings.backgroundVisible) out.L += beta * s.environment.Le(ray.d);
+          if (s.settings.backgroundVisible) {
+            const RGB Le = s.environment.Le(ray.d);
+            out.L += beta * Le;
+            // The background as the albedo guide, clamped to an albedo's
+            // range (OIDN's advice for what a camera ray sees directly).
+            if (s.settings.firstHitGuides) out.albedo = RGB(Min(1.f, Le.r), Min(1.f, Le.g), Min(1.f, Le.b));
+          }
         } else {
           float lightPdf;
           RGB Le = s.environment.LeAndPdf(ray.d, &lightPdf);
@@ -107,6 +113,16 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     Vec3 p = ray(fp.t), wo = -ray.d;
     MaterialCoefficients k = s.classifier.Coefficients(fp.c);
     out.L += beta * k.emission;
+    // The camera vertex's gradient, for the guides and the surface below.
+    const bool guides = depth == 0 && s.settings.firstHitGuides;
+    Vec3 firstGradient;
+    if (guides) {
+      firstGradient = s.classifier.Gradient(p);
+      out.albedo = RGB(Min(1.f, k.albedo.r + k.emission.r), Min(1.f, k.albedo.g + k.emission.g),
+                       Min(1.f, k.albedo.b + k.emission.b));
+      const float len = Length(firstGradient);
+      if (len > 0.f && isfinite(len)) out.normal = Dot(firstGradient, ray.d) > 0.f ? firstGradient / -len : firstGradient / len;
+    }
     if (depth >= s.settings.maxBounces) break;
 
     // Which particle scattered: surface (BSDF) with probability P_fs.
@@ -115,7 +131,7 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     float ldParticle[2];
     if (ld) ld->Get(pairBase + kPairParticle, &ldParticle[0], &ldParticle[1]);
     if (k.surfaceProbability > 0.f && (ld ? ldParticle[0] : rng.Uniform()) < k.surfaceProbability) {
-      Vec3 G = s.classifier.Gradient(p);
+      Vec3 G = guides ? firstGradient : s.classifier.Gradient(p);
       float len = Length(G);
       if (len > 0.f && isfinite(len)) {
         surface = true;

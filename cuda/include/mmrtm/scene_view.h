@@ -55,6 +55,9 @@ struct IntegratorSettings {
   PixelSampler sampler = PixelSampler::Sobol;
   uint64_t seed = 0;
   ProjectionSettings projection;
+  // Whether Li reports the denoiser's guides (PixelSample::albedo and
+  // normal). They use no random numbers: the radiance is the same either way.
+  bool firstHitGuides = false;
 };
 
 // A half-space that is kept: points with Dot(normal, p) + offset >= 0 (VTK's
@@ -116,6 +119,12 @@ struct SceneView {
 struct PixelSample {
   RGB L;
   float alpha = 0.f;
+  // The denoiser's guides (IntegratorSettings::firstHitGuides), where the
+  // camera ray first collides: the albedo (a glowing material's bounded
+  // emission, which is its colour) and the unit gradient normal facing the
+  // camera; zero where the ray escapes or the point has no gradient.
+  RGB albedo;
+  Vec3 normal;
 };
 
 }  // namespace mmrtm
