@@ -44,32 +44,26 @@ def data_path(name):
     return str(DATA / name)
 
 
-# The reference scenes of Documentation/accuracy.md: input and options of
-# mmrtm-render. Every one is 256 x 256 and uses the scene's own camera.
-SCENES = {
-    "head_ct_bone": {
-        "title": "head CT, ct-bone",
-        "args": [data_path("ct_head_cranium.nrrd"), "--preset", "ct-bone"],
-    },
-    "chest_ct": {
-        "title": "chest CT (DICOM), ct-soft-tissue",
-        "args": [data_path("ct_chest_dicom"), "--preset", "ct-soft-tissue"],
-    },
-    "cta_labels": {
-        "title": "chest CTA, vessel labels as materials",
-        "args": [data_path("cta_chest_aorta.nii.gz"), "--labels", data_path("cta_chest_aorta_labels.nii.gz"),
-                 "--preset", "ct-angio-labels"],
-    },
-    "bonsai": {
-        "title": "bonsai",
-        "args": [data_path("bonsai.nii.gz"), "--scene", str(ROOT / "Data" / "benchmarks" / "bonsai.json")],
-    },
-    "mri_labels": {
-        "title": "MRI head, brain and skull labels",
-        "args": [data_path("mr_head.nii.gz"), "--labels", data_path("mr_head_labels.nii.gz"),
-                 "--scene", str(ROOT / "Data" / "benchmarks" / "mr_head_labels.json")],
-    },
-}
+# The reference scenes of Documentation/accuracy.md (reference_scenes.json,
+# which the C++ tests read too), as title and mmrtm-render arguments. Every
+# one is 256 x 256 and uses the scene's own camera.
+def _reference_scenes():
+    with open(Path(__file__).with_name("reference_scenes.json")) as f:
+        listed = {name: scene for name, scene in json.load(f).items() if not name.startswith("_")}
+    scenes = {}
+    for name, s in listed.items():
+        args = [data_path(s["volume"])]
+        if "labels" in s:
+            args += ["--labels", data_path(s["labels"])]
+        if "preset" in s:
+            args += ["--preset", s["preset"]]
+        if "scene" in s:
+            args += ["--scene", str(ROOT / s["scene"])]
+        scenes[name] = {"title": s["title"], "args": args}
+    return scenes
+
+
+SCENES = _reference_scenes()
 
 REFERENCE_SIZE = 256
 

@@ -29,7 +29,8 @@ from pathlib import Path
 # (name, executable, arguments, needs an X server): the tests that catch
 # the defects, cheapest first (each defect stops at its first catch). The
 # executables are targets of the build; the mapper check renders through
-# VTK (headless). Measured: no defect passes them in about 40 s.
+# VTK (headless). Measured: no defect passes them in about 40 s, and the
+# denoised display's check on the reference scenes takes about a minute.
 CHECKS = [
     ("TestTransferFunctions", "TestTransferFunctions", [], False),
     ("TestSimdBackend", "TestSimdBackend", [], False),
@@ -43,11 +44,13 @@ CHECKS = [
      False),
     ("TestMajorantGrid minorants", "TestMajorantGrid", ["--gtest_filter=Accelerators/Conservative.Minorants*"], False),
     ("TestMapperEdits", "TestMapperEdits", [], True),
+    ("TestDenoisedDisplay reference scenes", "TestDenoisedDisplay",
+     ["--gtest_filter=DenoisedDisplayOnReferenceScenes.*"], False),
 ]
 
 DEFECTS = ["volume_albedo", "diffuse_lobe", "specular_lobe", "phase_sign", "majorant_low", "minorant_high",
            "shadow_last_segment", "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-           "film_variance", "simd_extinction"]
+           "film_variance", "simd_extinction", "denoise_variance"]
 
 
 def configure_and_build(source, build):

@@ -36,6 +36,7 @@ enum class Defect : uint8_t {
   LabelSwap,          // label materials 1 and 2 swapped
   FilmVariance,       // the film's variance of the mean halved
   SimdExtinction,     // the SIMD lanes' extinction x0.98 (the scalar lookups untouched)
+  DenoiseVariance,    // Auto's estimate subtracts Var A + Var B (the halves' whole difference), not Var B
   Count
 };
 
@@ -44,7 +45,7 @@ inline const char* DefectName(Defect d) {
   static const char* const names[] = {"none",          "volume_albedo",   "diffuse_lobe",       "specular_lobe",
                                       "phase_sign",    "majorant_low",    "minorant_high",      "shadow_last_segment",
                                       "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-                                      "film_variance", "simd_extinction"};
+                                      "film_variance", "simd_extinction", "denoise_variance"};
   static_assert(sizeof(names) / sizeof(names[0]) == (size_t)Defect::Count, "a name per defect");
   return names[(int)d];
 }
