@@ -513,6 +513,7 @@ void ViewerScene::SetSettings(const RenderSettings& s) {
   mapper_->SetAccelerator(s.accelerator);
   mapper_->SetBackend(s.backend);
   mapper_->SetExposure(s.exposure);
+  mapper_->SetDenoisingMode(s.denoising);
   if (image_) Apply();
 }
 

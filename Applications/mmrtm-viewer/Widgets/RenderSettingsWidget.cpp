@@ -36,6 +36,9 @@ RenderSettingsWidget::RenderSettingsWidget(QWidget* parent) : QWidget(parent) {
   backend_ = new QComboBox;
   backend_->addItems({tr("auto"), tr("CPU"), tr("CUDA")});
   exposure_ = Number(0.01, 100.0, 0.1, 2);
+  denoising_ = new QComboBox;
+  denoising_->addItems({tr("unbiased image"), tr("denoised while closer (auto)"), tr("denoised")});
+  denoising_->setToolTip(tr("What the view shows. The unbiased accumulation goes on underneath either way."));
   lightAzimuth_ = Number(-180, 180, 5, 0);
   lightElevation_ = Number(-90, 90, 5, 0);
   lightIntensity_ = Number(0, 100, 0.5, 2);
@@ -49,6 +52,7 @@ RenderSettingsWidget::RenderSettingsWidget(QWidget* parent) : QWidget(parent) {
   form->addRow(tr("Accelerator"), accelerator_);
   form->addRow(tr("Backend"), backend_);
   form->addRow(tr("Exposure"), exposure_);
+  form->addRow(tr("Display"), denoising_);
   form->addRow(tr("Light azimuth (deg)"), lightAzimuth_);
   form->addRow(tr("Light elevation (deg)"), lightElevation_);
   form->addRow(tr("Light intensity"), lightIntensity_);
@@ -64,7 +68,8 @@ RenderSettingsWidget::RenderSettingsWidget(QWidget* parent) : QWidget(parent) {
     connect(box, &QSpinBox::valueChanged, this, changed);
   for (QDoubleSpinBox* box : {noiseTarget_, shadowScale_, exposure_, lightAzimuth_, lightElevation_, lightIntensity_})
     connect(box, &QDoubleSpinBox::valueChanged, this, changed);
-  for (QComboBox* box : {stop_, accelerator_, backend_}) connect(box, &QComboBox::currentIndexChanged, this, changed);
+  for (QComboBox* box : {stop_, accelerator_, backend_, denoising_})
+    connect(box, &QComboBox::currentIndexChanged, this, changed);
   connect(environment_, &QCheckBox::toggled, this, changed);
 }
 
@@ -81,6 +86,7 @@ void RenderSettingsWidget::setSettings(const RenderSettings& s) {
   accelerator_->setCurrentIndex(s.accelerator);
   backend_->setCurrentIndex(s.backend);
   exposure_->setValue(s.exposure);
+  denoising_->setCurrentIndex(s.denoising);
   lightAzimuth_->setValue(s.lightAzimuth);
   lightElevation_->setValue(s.lightElevation);
   lightIntensity_->setValue(s.lightIntensity);
@@ -99,6 +105,7 @@ RenderSettings RenderSettingsWidget::settings() const {
   s.accelerator = accelerator_->currentIndex();
   s.backend = backend_->currentIndex();
   s.exposure = exposure_->value();
+  s.denoising = denoising_->currentIndex();
   s.lightAzimuth = lightAzimuth_->value();
   s.lightElevation = lightElevation_->value();
   s.lightIntensity = lightIntensity_->value();

@@ -24,6 +24,7 @@ struct RenderSettings {
   int accelerator = 0;  // 0 octree, 1 macrocell, 2 none
   int backend = 0;      // 0 auto, 1 CPU, 2 CUDA
   double exposure = 1.0;
+  int denoising = 1;  // what the view shows: 0 the unbiased image, 1 denoised while closer (auto), 2 denoised
   double lightAzimuth = -35, lightElevation = 40, lightIntensity = 3.0;
   bool environment = true;
 };
@@ -41,7 +42,7 @@ class RenderSettingsWidget : public QWidget {
 
  private:
   QSpinBox *samplesPerRender_, *maximumSamples_, *bounces_;
-  QComboBox *stop_, *accelerator_, *backend_;
+  QComboBox *stop_, *accelerator_, *backend_, *denoising_;
   QDoubleSpinBox *noiseTarget_, *shadowScale_, *exposure_, *lightAzimuth_, *lightElevation_, *lightIntensity_;
   QCheckBox* environment_;
   bool filling_ = false;
