@@ -105,6 +105,11 @@ void vtkMultiMaterialVolumeRepresentation::SetExposure(double exposure)
   this->Mapper()->SetExposure(exposure);
 }
 
+void vtkMultiMaterialVolumeRepresentation::SetDenoisingMode(int mode)
+{
+  this->Mapper()->SetDenoisingMode(mode);
+}
+
 void vtkMultiMaterialVolumeRepresentation::SetLinearImageFile(const char* path)
 {
   this->Mapper()->SetLinearImageFile(path);

@@ -103,6 +103,13 @@ public:
    */
   void SetExposure(double exposure);
 
+  /**
+   * What the view shows: 0 the accumulated image, 1 (the default) denoised
+   * while that is estimated closer to the truth, 2 denoised
+   * (vtkMultiMaterialVolumeMapper::SetDenoisingMode).
+   */
+  void SetDenoisingMode(int mode);
+
   ///@{
   /**
    * A preset of the project ("ct-bone", "mri", ...) or a scene file (JSON):

@@ -49,6 +49,8 @@ check(traced.max() > 100 and a.mean() > 0.05,
       "the path-traced head CT is not blank (max %d, %.0f %% of the pixels)" % (traced.max(), 100 * a.mean()))
 check(traced.mean() < 200, "nor blown out (mean %.1f)" % traced.mean())
 check(iou > 0.85, "its silhouette matches ParaView's Volume representation: IoU %.3f" % iou)
+check(s.display.Denoise == "Auto", "the view is denoised while that is closer by default (Denoise %s)"
+      % s.display.Denoise)
 samples = s.counter("AccumulatedSamples")
 check(samples == 64, "one still render gives the default 64 samples a pixel (%d)" % samples)
 
@@ -103,6 +105,7 @@ for name, edit, expected in (
         ("window size", lambda: setattr(s.view, "ViewSize", [240, 256]), (0, 0, 1, 0, 0)),
         ("sampling setting", lambda: setattr(s.display, "MaximumBounces", 3), (0, 0, 1, 0, 0)),
         ("exposure", lambda: setattr(s.display, "PathTracingExposure", 1.5), (0, 0, 0, 0, 0)),
+        ("denoise", lambda: setattr(s.display, "Denoise", "Always"), (0, 0, 0, 0, 0)),
         ("colour point", edit_colour, (0, 1, 1, 0, 0)),
         ("opacity point", edit_opacity, (0, 1, 1, 0, 1))):
     before = work()

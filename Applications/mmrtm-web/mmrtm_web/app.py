@@ -26,6 +26,9 @@ DEFAULT_PRESET = "CT-Bone"
 # The materials menu's first entry: the volume property translated, as
 # Volume Rendering's preset and the editor make it.
 VOLUME_PROPERTY_MATERIALS = "From the volume property"
+# What the 3D view shows (the display node's DenoisingMode), by the page's names.
+DISPLAYS = {"Denoised while closer": 1, "Denoised": 2, "Unbiased": 0}
+DEFAULT_DISPLAY = "Denoised while closer"
 
 
 def material_presets():
@@ -112,6 +115,8 @@ class WebViewer:
         state.shift, state.shift_range = 0.0, [-1000.0, 1000.0]
         state.samples_per_render, state.maximum_samples, state.noise_target = 4, maximum_samples, 0.0
         state.samples, state.noise, state.refining, state.frames = 0, 0.0, False, 0
+        state.displays, state.display = list(DISPLAYS), DEFAULT_DISPLAY
+        state.display_status, state.denoises = "", 0
         state.opacity_points, state.colour_points = [], []
         state.segmentation_path = ""
         state.segments = []
@@ -121,7 +126,8 @@ class WebViewer:
         state.change("method")(self.on_method)
         state.change("study")(self.on_study_chosen)
         state.change("shift")(self.on_shift)
-        state.change("samples_per_render", "maximum_samples", "noise_target", "material_preset")(self.on_settings)
+        state.change("samples_per_render", "maximum_samples", "noise_target", "material_preset",
+                     "display")(self.on_settings)
         state.change("upload")(self.on_upload)
         self.server.controller.open_study = self.on_open_study
         self.server.controller.open_segmentation = self.on_open_segmentation
@@ -205,6 +211,7 @@ class WebViewer:
             display.SetSamplesPerRender(max(1, int(state.samples_per_render)))
             display.SetMaximumSamples(max(1, int(state.maximum_samples)))
             display.SetNoiseTarget(max(0.0, min(1.0, float(state.noise_target) / 100)))
+            display.SetDenoisingMode(DISPLAYS.get(state.display, DISPLAYS[DEFAULT_DISPLAY]))
             materials = state.material_preset
             display.SetMaterialPreset(materials if materials in state.material_presets[1:] else "")
             if self.segmentation is not None:
@@ -356,7 +363,7 @@ class WebViewer:
             self.show_transfer_functions()
 
     def on_settings(self, **_):
-        """Samples per pass, maximum samples, noise target, materials."""
+        """Samples per pass, maximum samples, noise target, materials, display."""
         display = self.display_node()
         if display is not None and display.IsA(METHOD):
             try:
@@ -369,12 +376,14 @@ class WebViewer:
         with self.server.state as state:
             state.frames = frames
             if not mappers:
-                state.samples, state.noise, state.refining = 0, 0.0, False
+                state.samples, state.noise, state.refining, state.display_status = 0, 0.0, False, ""
                 return
             mapper = mappers[0]
             state.samples = mapper.GetAccumulatedSamples()
             state.noise = round(100 * mapper.GetRelativeNoise(), 2)
             state.refining = not mapper.IsConverged()
+            state.display_status = mapper.GetDisplayStatus()
+            state.denoises = mapper.GetNumberOfDenoises()
 
     def screenshot_png(self):
         """The 3D view as it is now, as PNG bytes (lossless, unlike the

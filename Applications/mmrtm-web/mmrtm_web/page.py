@@ -24,9 +24,15 @@ def build_page(server, layouts):
         with ui.toolbar:
             vuetify3.VSpacer()
             html.Span("{{ shown }}", classes="shown-study text-body-2 mr-4")
+            # The accumulation, then what the view shows of it (the mapper's
+            # display status: "denoised, 8 samples", "unbiased, 32 samples,
+            # noise 2.1 %"); nothing is called converged before a sample.
             html.Span("{{ samples }} / {{ maximum_samples }} samples, noise {{ noise }} %"
-                      " {{ refining ? '(refining)' : '(converged)' }}",
-                      v_if=("method.startsWith('Path')",), classes="refinement-status text-body-2 mr-4")
+                      " {{ refining ? '(refining)' : samples ? '(converged)' : '(starting)' }}",
+                      v_if=("method.startsWith('Path')",), classes="refinement-status text-body-2 mr-2")
+            html.Span("shown: {{ display_status }}", v_if=("method.startsWith('Path') && display_status",),
+                      classes="display-status text-body-2 mr-4")
+            html.Span("{{ denoises }}", classes="denoise-count d-none")
             # Frames rendered since the server started: the browser test
             # compares it with the frames it received and the passes.
             html.Span("{{ frames }}", classes="frame-count d-none")
@@ -81,6 +87,8 @@ def build_page(server, layouts):
                                            style="width: 28px; height: 22px")
                 vuetify3.VSelect(v_model=("method",), items=("methods",), label="Rendering", density="compact",
                                  hide_details=True, classes="method-select")
+                vuetify3.VSelect(v_model=("display",), items=("displays",), label="3D view shows",
+                                 density="compact", hide_details=True, classes="display-select")
                 html.Div("Refinement", classes="text-subtitle-2 mt-2")
                 vuetify3.VTextField(v_model_number=("samples_per_render",), type="number", min=1,
                                     label="Samples per pass", density="compact", hide_details=True,

@@ -130,9 +130,12 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         return False
 
     def progress(self, mappers):
-        """What a render may change: the samples, and whether the window
-        renders previews (an interaction sets its desired update rate)."""
-        return [m.GetAccumulatedSamples() for m in mappers], self.render_window.GetDesiredUpdateRate()
+        """What a render may change: the samples, the denoised images made
+        (a denoise in the background ends like a pass), and whether the
+        window renders previews (an interaction sets its desired update
+        rate)."""
+        return ([(m.GetAccumulatedSamples(), m.GetNumberOfDenoises()) for m in mappers],
+                self.render_window.GetDesiredUpdateRate())
 
     def push_frame(self):
         self._render_frame(self._interactive_quality)
@@ -201,7 +204,7 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
             # accumulate), or after a render that was not asked for and
             # neither drew samples nor started a pass.
             # A change's preview is followed by its first pass.
-            preview = mappers and not any(after[0]) and not changed
+            preview = mappers and not any(samples for samples, _ in after[0]) and not changed
             idle = not any(m.IsRefining() for m in mappers)
             self.stalled_at = after if idle and (preview or (not requested and after == before)) else None
             if self.on_frame is not None:
