@@ -26,6 +26,10 @@ DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 OUTPUT = os.environ.get("MMRTM_TEST_OUTPUT_DIR", os.getcwd())
 CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 MAXIMUM_SAMPLES, SAMPLES_PER_PASS = 32, 4  # the server's --maximum-samples; the display node's default
+# A drag's preview against the image at rest at its camera: the RMS
+# difference in levels (test_k) above which the preview is the unbiased
+# display's one-sample noise.
+DRAG_ERROR_BOUND = 30.0
 
 # The 3D view's frame: the largest streamed <img>, drawn into a canvas to
 # read its pixels (width w, height h, RGBA p); null before the first frame.
@@ -103,6 +107,35 @@ for (let i = 0; i < w * h; i++) {
   if (d > 30) { changed++; onVolume += keptMask[i]; }
 }
 return changed ? [onVolume / changed, changed / Math.max(volume, 1)] : [-1, 0];
+"""
+
+# The frame's pixels kept under a name (arguments[0]), to compare later.
+KEEP_FRAME = FRAME_PIXELS + """
+window.mmrtmFrames = window.mmrtmFrames || {};
+window.mmrtmFrames[arguments[0]] = [w, h, p];
+return [w, h];
+"""
+
+# The RMS difference (levels, over pixels and channels) between the frames
+# kept as arguments[0] and arguments[1], on the pixels where either shows
+# the volume (FRAME_STATISTICS' rule against its row's first pixel); -1 if
+# they differ in size.
+FRAME_DIFFERENCE = """
+const [wa, ha, a] = window.mmrtmFrames[arguments[0]], [wb, hb, b] = window.mmrtmFrames[arguments[1]];
+if (wa !== wb || ha !== hb) return -1;
+let sum = 0, n = 0;
+for (let y = 0; y < ha; y++) {
+  const r = 4 * y * wa;
+  for (let x = 0; x < wa; x++) {
+    const i = r + 4 * x;
+    const va = Math.abs(a[i] - a[r]) + Math.abs(a[i + 1] - a[r + 1]) + Math.abs(a[i + 2] - a[r + 2]) > 30;
+    const vb = Math.abs(b[i] - b[r]) + Math.abs(b[i + 1] - b[r + 1]) + Math.abs(b[i + 2] - b[r + 2]) > 30;
+    if (!va && !vb) continue;
+    for (let c = 0; c < 3; c++) sum += (a[i + c] - b[i + c]) ** 2;
+    n += 3;
+  }
+}
+return Math.sqrt(sum / Math.max(n, 1));
 """
 
 # Records, in the page, when each streamed frame arrived (its size) and
@@ -390,6 +423,13 @@ class WebViewerTest(unittest.TestCase):
         self.assertTrue(match, "the toolbar's refinement state: %r" % text)
         return int(match[1]), int(match[2]), match[3] == "converged"
 
+    def denoises(self):
+        return int(self.browser.find_element("css selector", ".denoise-count").get_attribute("textContent"))
+
+    def display_status(self):
+        shown = self.browser.find_elements("css selector", ".display-status")
+        return shown[0].text if shown else ""
+
     def frames_rendered(self):
         return int(self.browser.find_element("css selector", ".frame-count").get_attribute("textContent"))
 
@@ -437,7 +477,7 @@ class WebViewerTest(unittest.TestCase):
         too slow to follow the mouse."""
         self.show_converged("ct_head_cranium.nrrd", "CT-Bone")
         time.sleep(1)
-        frames, loads = self.frames_rendered(), len(self.view_loads())
+        frames, loads, denoises = self.frames_rendered(), len(self.view_loads()), self.denoises()
         self.choose("preset-select", "CT-Muscle")
         clicked = time.monotonic()
         self.wait_converged(frames)
@@ -445,9 +485,12 @@ class WebViewerTest(unittest.TestCase):
         time.sleep(1)  # the last frame's way to the browser
         rendered, received = self.frames_rendered() - frames, len(self.view_loads()) - loads
         passes = MAXIMUM_SAMPLES // SAMPLES_PER_PASS
-        print("restart to %d samples: %.1f s, %d passes, %d frames rendered, %d received"
-              % (MAXIMUM_SAMPLES, converged_after, passes, rendered, received))
-        self.assertEqual(rendered, passes + 1, "the change's preview, then one frame a pass")
+        # The preview is denoised with it; each denoise of the film after it
+        # ends in the background like a pass, and is a frame of its own.
+        stills = self.denoises() - denoises - 1
+        print("restart to %d samples: %.1f s, %d passes, %d denoised stills, %d frames rendered, %d received"
+              % (MAXIMUM_SAMPLES, converged_after, passes, stills, rendered, received))
+        self.assertEqual(rendered, passes + stills + 1, "the change's preview, then one frame a pass or a denoise")
         self.assertTrue(rendered - 1 <= received <= rendered, "the browser gets them")
 
         kept = self.frame(5, keep=True)
@@ -656,6 +699,76 @@ class WebViewerTest(unittest.TestCase):
         self.assertLess(back[4], 2.0)
         self.assertGreater(iou, 0.95)
 
+
+    def keep_converged_reference(self, name, frames):
+        """Waits for refinement to end (after frame `frames`), shows it
+        denoised while closer (the default; no restart), and keeps that
+        frame as `name`: the image at rest the other frames are compared
+        with."""
+        self.wait_converged(frames)
+        if self.browser.find_element("css selector", ".display-select .v-select__selection").text != "Denoised while closer":
+            self.choose("display-select", "Denoised while closer")
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (self.status()[2] and self.display_status()):
+            time.sleep(0.2)
+        time.sleep(1)  # its frame's way to the browser
+        self.browser.execute_script(KEEP_FRAME, name)
+
+    def drag_and_hold(self, name):
+        """Drags the view 80 pixels to the right, holds still with the
+        button down (the interaction goes on: its last frame is a preview
+        at the final camera), keeps that frame as `name`, and releases."""
+        view = self.browser.execute_script(
+            "return Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0)"
+            ".reduce((a, b) => a.naturalWidth * a.naturalHeight >= b.naturalWidth * b.naturalHeight ? a : b)")
+        drag = ActionChains(self.browser, duration=0).move_to_element(view).click_and_hold()
+        for _ in range(10):
+            drag.move_by_offset(8, 0).pause(0.1)
+        drag.pause(1.5).perform()
+        self.browser.execute_script(KEEP_FRAME, name)
+        frames = self.frames_rendered()
+        ActionChains(self.browser, duration=0).release().perform()
+        return frames
+
+    def test_k_the_view_is_clean_during_a_drag_and_after_a_preset(self):
+        """What the 3D view shows, against the refined image at the same
+        camera (denoised while closer, the default, at rest): the preview
+        streamed during a drag (the last frame while the button is still
+        held) and the frame 2 s after a preset, with the default display
+        and with the unbiased one. Catches previews that show one-sample
+        noise (the unbiased display's: the bound is set between the two),
+        a default that is not denoised, and a preset whose first frames
+        stay noisy."""
+        self.show_converged("ct_head_cranium.nrrd", "CT-Bone")
+        errors = {}
+        for display in ("Denoised while closer", "Unbiased"):
+            self.choose("display-select", display)
+            time.sleep(1)
+            frames = self.drag_and_hold("drag " + display)
+            self.keep_converged_reference("rest " + display, frames)
+            errors["drag", display] = self.browser.execute_script(FRAME_DIFFERENCE, "drag " + display,
+                                                                  "rest " + display)
+        # A preset, then the same preset's frame 2 s after it is chosen
+        # again, with each display; both against the image at rest.
+        for display in ("Unbiased", "Denoised while closer"):
+            self.choose("display-select", display)
+            self.choose("preset-select", "CT-Bone")
+            time.sleep(2)
+            frames = self.frames_rendered()
+            self.choose("preset-select", "CT-Muscle")
+            time.sleep(2)
+            self.browser.execute_script(KEEP_FRAME, "preset " + display)
+            print("2 s after the preset, %s: %s" % (display, self.display_status()))
+        self.keep_converged_reference("rest preset", frames)
+        for display in ("Unbiased", "Denoised while closer"):
+            errors["preset", display] = self.browser.execute_script(FRAME_DIFFERENCE, "preset " + display,
+                                                                    "rest preset")
+        print("RMS difference from the image at rest (levels): " + ", ".join(
+            "%s %s %.1f" % (what, display, e) for (what, display), e in errors.items()))
+        self.browser.save_screenshot(os.path.join(OUTPUT, "mmrtm-web-denoised.png"))
+        self.assertLess(errors["drag", "Denoised while closer"], DRAG_ERROR_BOUND)
+        self.assertGreater(errors["drag", "Unbiased"], DRAG_ERROR_BOUND, "the bound tells today's previews apart")
+        self.assertLess(errors["preset", "Denoised while closer"], errors["preset", "Unbiased"])
 
 if __name__ == "__main__":
     unittest.main()
