@@ -961,6 +961,136 @@ class MapperTest(unittest.TestCase):
         self.assertEqual(a.pixels(), b.pixels())
 
 
+def film(mapper):
+    image = vtkImageData()
+    mapper.GetAccumulatedImage(image)
+    a = image.GetPointData().GetScalars()
+    return bytes(memoryview(a)) if a is not None else b""
+
+
+def displayed(mapper):
+    image = vtkImageData()
+    mapper.GetDisplayedImage(image)
+    a = image.GetPointData().GetScalars()
+    return [a.GetValue(i) for i in range(a.GetNumberOfTuples() * 4) if i % 4 < 3]
+
+
+def roughness(values, width=128):
+    """Mean absolute difference between horizontal neighbours (RGB)."""
+    diffs = [abs(values[i] - values[i - 3]) for i in range(3, len(values)) if (i // 3) % width]
+    return sum(diffs) / len(diffs)
+
+
+class DenoisingTest(unittest.TestCase):
+    """The mapper's DenoisingMode (Documentation/denoising.md) on the head CT
+    at 128 x 128: what is shown, that the accumulation is the same to the
+    bit in every mode and through a change of mode, when a denoise runs and
+    what the status says. Catches a display that writes into the film, a
+    mode change that restarts, a denoised image that is not drawn or not
+    smoother, and a converged state before the last denoise."""
+
+    @classmethod
+    def setUpClass(cls):
+        probe = Scene()
+        probe.mapper.SetDenoisingModeToAlways()
+        probe.render()
+        if "Open Image Denoise not found" in probe.mapper.GetDisplayStatus():
+            raise unittest.SkipTest("no Open Image Denoise library (scripts/install-dependencies.sh installs the "
+                                    "pyoidn wheel)")
+
+    def test_every_mode_accumulates_the_same_film(self):
+        films, shown = {}, {}
+        for mode in ("Off", "Auto", "Always"):
+            s = Scene()
+            getattr(s.mapper, "SetDenoisingModeTo" + mode)()
+            for _ in range(4):
+                s.render()
+            self.assertEqual(s.mapper.GetAccumulatedSamples(), 8)
+            films[mode], shown[mode] = film(s.mapper), s.mapper.IsDenoisedImageShown()
+            print("%s: %s" % (mode, s.mapper.GetDisplayStatus()))
+        self.assertEqual(films["Auto"], films["Off"])
+        self.assertEqual(films["Always"], films["Off"])
+        self.assertEqual(shown, {"Off": False, "Auto": True, "Always": True})
+
+    def test_a_change_of_mode_keeps_the_accumulation(self):
+        s = Scene()
+        s.mapper.SetMaximumSamples(16)
+        for _ in range(3):
+            s.render()
+        counts, before = s.counts(), film(s.mapper)
+        self.assertRegex(s.mapper.GetDisplayStatus(), r"^unbiased, 6 samples, noise [\d.]+ %$")
+        s.mapper.SetDenoisingModeToAuto()
+        s.render()
+        self.assertEqual(s.counts(), counts, "no restart, no refit")
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 8, "the samples go on")
+        self.assertEqual(s.mapper.GetDisplayStatus(), "denoised, 8 samples")
+        denoised_film = displayed(s.mapper)
+        s.mapper.SetDenoisingModeToOff()
+        self.assertEqual(displayed(s.mapper), [v for i, v in enumerate(
+            memoryview_floats(film(s.mapper))) if i % 4 < 3], "Off shows the film")
+        self.assertLess(roughness(denoised_film), 0.5 * roughness(displayed(s.mapper)),
+                        "the denoised image is smoother than the film it was made from")
+        self.assertNotEqual(before, film(s.mapper))
+
+    def test_converged_only_after_the_last_denoise(self):
+        import time
+        s = Scene()
+        s.mapper.SetDenoisingModeToAlways()
+        s.mapper.AsynchronousRefinementOn()
+        s.render()  # the first pass, in the render: its denoise comes later, in the background
+        self.assertFalse(s.mapper.IsConverged())
+        renders = 0
+        while not s.mapper.IsConverged() and renders < 4000:
+            s.render()
+            renders += 1
+            time.sleep(0.005)
+        self.assertTrue(s.mapper.IsConverged())
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 8)
+        self.assertEqual(s.mapper.GetDisplayStatus(), "denoised, 8 samples")
+        self.assertGreaterEqual(s.mapper.GetNumberOfDenoises(), 2)
+        self.assertGreater(s.mapper.GetDenoisingSeconds(), 0.0)
+        seconds = s.mapper.GetDenoisingSeconds()
+        s.render()
+        self.assertEqual(s.mapper.GetDenoisingSeconds(), seconds, "converged: nothing more to denoise")
+
+    def test_a_preview_is_denoised_and_stands_until_the_first_denoise(self):
+        s = Scene()
+        s.mapper.SetDenoisingModeToAuto()
+        s.mapper.AsynchronousRefinementOn()
+        s.render()
+        s.window.SetDesiredUpdateRate(15.0)
+        s.renderer.GetActiveCamera().Azimuth(10)
+        s.render()
+        self.assertEqual(s.mapper.GetDisplayStatus(), "preview, denoised")
+        preview = s.pixels()
+        s.window.SetDesiredUpdateRate(0.0001)
+        s.render()  # the first pass at the camera where the drag ended: the preview still stands
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 2)
+        self.assertEqual(s.mapper.GetDisplayStatus(), "preview, denoised")
+        self.assertEqual(s.pixels(), preview)
+
+    def test_without_the_library_the_film_is_shown_and_the_status_says_why(self):
+        script = ("import sys; sys.path.insert(0, %r)\n"
+                  "from test_mapper import Scene\n"
+                  "s = Scene(); s.mapper.SetDenoisingModeToAuto()\n"
+                  "for _ in range(4): s.render()\n"
+                  "print(s.mapper.GetDisplayStatus()); print(s.mapper.IsConverged())\n"
+                  % os.path.dirname(os.path.abspath(__file__)))
+        env = dict(os.environ, MMRTM_OIDN_LIBRARY="/nonexistent/libOpenImageDenoise.so.2")
+        done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=300)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        status, converged = done.stdout.strip().splitlines()[-2:]
+        self.assertRegex(status, r"^unbiased, 8 samples, noise [\d.]+ % \(not denoised: Intel Open Image Denoise "
+                                 r"not found\)$")
+        self.assertEqual(converged, "True")
+        self.assertEqual(done.stderr.count("Open Image Denoise not found"), 1, "warned once: " + done.stderr)
+
+
+def memoryview_floats(data):
+    import struct
+    return struct.unpack("%df" % (len(data) // 4), data)
+
+
 class ReaderTest(unittest.TestCase):
     def test_a_jpeg2000_dicom_series_reads_or_is_a_clear_error(self):
         # With ITK/GDCM (the Debian build) the series decodes in Hounsfield

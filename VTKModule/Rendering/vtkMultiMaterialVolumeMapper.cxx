@@ -230,6 +230,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::unique_ptr<mmrtm::Denoiser> Denoiser; // loaded at the first need
   bool DenoiserLoadTried = false;
   std::optional<mmrtm::DenoisedFilm> PreviewDenoised; // the interactive preview, when denoised
+  uint64_t PreviewStandsFor = 0;                       // the accumulation it stands for (RenderFrame), or 0
   double PreviewDenoiseSeconds = 0;
   int PreviewDenoises = 0;
   // What the last frame drew: the mapper's film (or the copy of it that
@@ -1055,6 +1056,12 @@ void vtkMultiMaterialVolumeMapper::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
       in.ParkedFilm.reset(); // accumulated under the scene before
     if (restart)
       this->UpdateView(ren, vol, now);
+    // A still render that restarts with nothing changed since the preview
+    // before it (the end of a drag, a front end's preview of a change):
+    // that preview, denoised, stands for the new accumulation until the
+    // first denoise of it (its first pass alone is the noisier image).
+    if (restart && !interactive)
+      in.PreviewStandsFor = !changes.Any() && in.PreviewDenoised ? in.FilmGeneration : 0;
     this->UpdateRenderer();
 
     if (interactive)
@@ -1867,8 +1874,6 @@ void vtkMultiMaterialVolumeMapper::AdaptPreview(double seconds, double tracedSec
 
 void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
 {
-  // The image: tone-mapped, premultiplied RGBA, bottom row first for OpenGL.
-  const int width = film.Width(), height = film.Height();
   // A projection's film holds VTK's colours made linear: no curve.
   const mmrtm::RenderSettings& rs = this->Internal->Scene.render;
   const bool description = this->Internal->MultiMaterial != nullptr;
@@ -1895,24 +1900,37 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
   }
   else if (&film == this->ImageFilm())
   {
+    in.LastShown = Internals::ShownImage::Film;
     if (const mmrtm::DenoisedFilm* shown = in.Display.Shown(in.FilmGeneration, film.Samples()))
     {
       denoised = &shown->image;
       denoisedAlpha = &shown->alpha;
     }
-    in.LastShown = Internals::ShownImage::Film;
+    else if (this->DenoisingMode != DENOISING_OFF && in.PreviewDenoised && in.PreviewStandsFor == in.FilmGeneration &&
+      !in.Display.HasDenoised(in.FilmGeneration))
+    {
+      denoised = &in.PreviewDenoised->image;
+      denoisedAlpha = &in.PreviewDenoised->alpha;
+      in.LastShown = Internals::ShownImage::Preview;
+    }
   }
   in.LastShownSamples = film.Samples();
   in.ShowedDenoised = denoised != nullptr;
-  std::vector<uint8_t> rgba = film.ToneMapped(static_cast<float>(this->Exposure), toneMapper, 4);
+  // The image: tone-mapped, premultiplied RGBA, bottom row first for OpenGL.
+  const int width = denoised ? denoised->width : film.Width(), height = denoised ? denoised->height : film.Height();
+  std::vector<uint8_t> rgba;
   if (denoised)
+  {
+    rgba.resize(4 * denoised->pixels.size());
     for (size_t i = 0; i < denoised->pixels.size(); ++i)
     {
       uint8_t* p = &rgba[4 * i];
       mmrtm::ToneMapPixel(denoised->pixels[i], static_cast<float>(this->Exposure), toneMapper, p);
-      if (denoisedAlpha)
-        p[3] = static_cast<uint8_t>(mmrtm::Clamp((*denoisedAlpha)[i], 0.f, 1.f) * 255.f + 0.5f);
+      p[3] = static_cast<uint8_t>(mmrtm::Clamp((*denoisedAlpha)[i], 0.f, 1.f) * 255.f + 0.5f);
     }
+  }
+  else
+    rgba = film.ToneMapped(static_cast<float>(this->Exposure), toneMapper, 4);
   const size_t row = 4 * static_cast<size_t>(width);
   for (int y = 0; y < height / 2; ++y)
     std::swap_ranges(rgba.begin() + y * row, rgba.begin() + (y + 1) * row, rgba.begin() + (height - 1 - y) * row);

@@ -414,8 +414,10 @@ public:
    * albedo and normal where the camera rays first collide, gathered with
    * the samples; it runs after a pass, at most a quarter of the time, on
    * the refinement thread with AsynchronousRefinement. Interactive
-   * previews are denoised too (colour only). Without the library the film
-   * is shown and GetDisplayStatus says why.
+   * previews are denoised too (colour only), and after one (the end of a
+   * drag, a front end's preview of a change) the denoised preview stays
+   * until the first denoised image of the new accumulation. Without the
+   * library the film is shown and GetDisplayStatus says why.
    */
   virtual void SetDenoisingMode(int mode);
   vtkGetMacro(DenoisingMode, int);

@@ -136,6 +136,8 @@ class DenoisedDisplay {
   // Why no denoiser runs (it could not be loaded), or empty.
   void SetUnavailable(std::string why) { unavailable_ = std::move(why); }
   const std::string& Unavailable() const { return unavailable_; }
+  // Whether a denoise of the accumulation `generation` has ended.
+  bool HasDenoised(uint64_t generation) const { return last_ && generation_ == generation; }
   // The latest estimate of the accumulation `generation`, if any.
   const DenoiseEstimate* Estimate(uint64_t generation) const;
 
