@@ -29,7 +29,7 @@ MAXIMUM_SAMPLES, SAMPLES_PER_PASS = 32, 4  # the server's --maximum-samples; the
 # A drag's preview against the image at rest at its camera: the RMS
 # difference in levels (test_k) above which the preview is the unbiased
 # display's one-sample noise.
-DRAG_ERROR_BOUND = 30.0
+DRAG_ERROR_BOUND = 20.0
 
 # The 3D view's frame: the largest streamed <img>, drawn into a canvas to
 # read its pixels (width w, height h, RGBA p); null before the first frame.
