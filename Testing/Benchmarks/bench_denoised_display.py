@@ -4,9 +4,13 @@ each DenoisingMode (Off: the unbiased film; Auto; Always), on the five
 reference scenes of Documentation/accuracy.md, and the interactive preview
 of a drag (its frame rate and its error) with and without denoising.
 
-    MMRTM_SHARED_DATA_DIR=../shared/data PYTHONPATH=build/lib/python3/dist-packages \\
-        Testing/headless.sh 1024x768x24 /usr/bin/python3 Testing/Benchmarks/bench_denoised_display.py \\
-        [--size 256] [--seconds 20] [--only NAME ...] [--json out.json] [--chart out.png]
+    MMRTM_SHARED_DATA_DIR=../shared/data Testing/headless.sh 1024x768x24 \\
+        .venv-vtk96/bin/python Testing/Benchmarks/bench_denoised_display.py \\
+        [--size 256] [--seconds 20] [--only NAME ...] --json out.json
+    .venv/bin/python Testing/Benchmarks/bench_denoised_display.py --chart out.json out.png
+
+(The VTK 9.6 venv has numpy and the mmrtm wheel the tests build; the
+chart is drawn with the accuracy venv's matplotlib.)
 
 Each scene goes through the mapper as a user's script makes it: the volume
 (and label map) read, the scene's preset or scene file as a
@@ -29,13 +33,16 @@ import sys
 import time
 
 import numpy as np
-from vtkmodules.vtkCommonDataModel import vtkImageData
-from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow, vtkVolume, vtkVolumeProperty
-import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
-import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
-from vtkmodules.util.numpy_support import vtk_to_numpy
 
-from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
+if "--chart" not in sys.argv:
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkRenderingCore import (vtkRenderer, vtkRenderWindow, vtkVolume, vtkVolumeProperty,
+                                             vtkWindowToImageFilter)
+    import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
+    import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 DATA = os.environ.get("MMRTM_SHARED_DATA_DIR", os.path.join(ROOT, "..", "shared", "data"))
@@ -181,7 +188,6 @@ def measure_drag(size, frames=12):
             m.GetLastFilmSize(film)
             # The preview is drawn stretched over the window: compared at the
             # window's size, read back from the frame buffer.
-            from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
             grab = vtkWindowToImageFilter()
             grab.SetInput(view.window)
             grab.SetInputBufferTypeToRGB()
@@ -213,6 +219,7 @@ def measure_drag(size, frames=12):
 
 
 def chart(results, path):
+    """Error against time, a panel a scene (results as --json writes them)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -245,15 +252,18 @@ def main():
     parser.add_argument("--drag-size", default="880x700", help="the drag's window (the browser test's 3D view)")
     parser.add_argument("--no-drag", action="store_true")
     parser.add_argument("--json", help="write the figures here too")
-    parser.add_argument("--chart", help="the error-against-time chart (PNG)")
+    parser.add_argument("--chart", nargs=2, metavar=("JSON", "PNG"),
+                        help="only draw the chart of a --json run")
     args = parser.parse_args()
+    if args.chart:
+        with open(args.chart[0]) as f:
+            chart(json.load(f)["scenes"], args.chart[1])
+        return
     scenes = reference_scenes()
     results = {}
     for name in args.only or scenes:
         results[name] = measure_scene(name, scenes[name], args.size, args.seconds)
     drag = None if args.no_drag else measure_drag(tuple(int(v) for v in args.drag_size.split("x")))
-    if args.chart:
-        chart(results, args.chart)
     if args.json:
         with open(args.json, "w") as out:
             json.dump({"scenes": {n: {m: {k: v for k, v in r.items() if k != "curve"} | {

@@ -172,10 +172,7 @@ void DenoisedDisplay::Finished(std::optional<DenoisedFilm> result, Clock::time_p
 
 const DenoisedFilm* DenoisedDisplay::Shown(uint64_t generation, uint32_t samples) const {
   if (mode_ == DenoisingMode::Off || !last_ || generation != generation_ || samples == 0) return nullptr;
-  if (mode_ == DenoisingMode::Always) return &*last_;
-  if (settledOnFilm_) return nullptr;
-  if (samples == 1) return &*last_;
-  return estimate_ && estimate_->DenoisedCloserAt(samples) ? &*last_ : nullptr;
+  return mode_ == DenoisingMode::Auto && settledOnFilm_ ? nullptr : &*last_;
 }
 
 const DenoiseEstimate* DenoisedDisplay::Estimate(uint64_t generation) const {

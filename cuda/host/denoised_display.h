@@ -123,10 +123,14 @@ class DenoisedDisplay {
   void Finished(std::optional<DenoisedFilm> result, Clock::time_point now = Clock::now());
 
   // The image to draw over the film of `generation` with `samples`: the
-  // denoised one, or null for the film itself. Auto shows it with one
-  // sample (there are no halves to estimate by, and a one-sample film was
-  // the farther on every reference scene: Documentation/denoising.md), and
-  // with more while the latest estimate says it is closer.
+  // newest denoised one, or null for the film itself. Auto shows it until
+  // an estimate finds the film closer, and the film from then on: a
+  // denoise of one sample needs none (there are no halves to estimate by,
+  // and a one-sample film was the farther on every reference scene:
+  // Documentation/denoising.md); an estimate whose bound the film has
+  // caught up with asks for a fresh one (WantsEstimate) and stands until
+  // it comes, so that the view does not fall back to the noisier film for
+  // the time between two denoises.
   const DenoisedFilm* Shown(uint64_t generation, uint32_t samples) const;
 
   // "denoised, 8 samples", "unbiased, 64 samples, noise 2.1 %" (noise:
