@@ -567,7 +567,9 @@ int Run(const Options& o) {
   json denoising = nullptr;
   std::optional<mmrtm::DenoisedFilm> denoised;
   bool showDenoised = false;
-  if (denoiser) denoising = DenoiseFilm(o, *denoiser, film, rs, &denoised, &showDenoised);
+  // A projection's one sample is its image: there is no noise to take out.
+  if (denoiser && rs.integrator.projection.mode == mmrtm::IntensityProjection::None)
+    denoising = DenoiseFilm(o, *denoiser, film, rs, &denoised, &showDenoised);
   if (showDenoised) {
     std::vector<uint8_t> png((size_t)film.Width() * film.Height() * 3);
     for (size_t i = 0; i < denoised->image.pixels.size(); ++i)
@@ -598,7 +600,9 @@ int Run(const Options& o) {
                  o.output.c_str(), film.MeanSamples(), film.Adaptive() ? " (mean, adaptive)" : "",
                  reachedTarget ? " (noise target reached)" : "", renderSeconds, samples / renderSeconds,
                  noise.relative);
-  if (denoiser && !o.quiet) {
+  if (denoiser && denoising.is_null() && !o.quiet)
+    std::fprintf(stderr, "note: a projection is not denoised (its one sample is its image)\n");
+  if (!denoising.is_null() && !o.quiet) {
     std::string estimate;
     if (!denoising["estimate"].is_null()) {
       char text[128];

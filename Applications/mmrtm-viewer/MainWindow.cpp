@@ -384,11 +384,14 @@ void MainWindow::updateStatus() {
   const int* size = view_->RenderWindow()->GetSize();
   const double seconds = sinceRestart_.isValid() ? sinceRestart_.elapsed() / 1000.0 : 0;
   const double rate = seconds > 0 ? double(samples - samplesAtRestart_) * size[0] * size[1] / seconds : 0;
-  status_->setText(tr("%1 samples/pixel   shown: %2   %3 Msamples/s   last refit %4 ms   %5%6")
+  const QString denoiser =
+      m->GetNumberOfDenoises() ? tr("   denoiser %1 s").arg(m->GetDenoisingSeconds(), 0, 'f', 1) : QString();
+  status_->setText(tr("%1 samples/pixel   shown: %2   %3 Msamples/s   last refit %4 ms%5   %6%7")
                        .arg(samples)
                        .arg(QString::fromUtf8(m->GetDisplayStatus()))
                        .arg(rate / 1e6, 0, 'f', 2)
                        .arg(m->GetLastRefitSeconds() * 1000, 0, 'f', 1)
+                       .arg(denoiser)
                        .arg(QString::fromUtf8(m->GetBackendDescription()))
                        .arg(m->IsConverged() ? tr("   (converged)") : QString()));
 }

@@ -3,6 +3,7 @@
 quality, and Auto's estimate, on the five reference scenes.
 
     Testing/Accuracy/denoise_guides.py [--only NAME ...] [--spp 1 2 4 8 16 32 64] [--json FILE]
+    Testing/Accuracy/denoise_guides.py --timing     # the filters' times at three sizes (a minute)
 
 Needs the references of make_references.py (256 x 256) and the pyoidn
 wheel of .venv. Per scene and sample count, one render (seed 11, unbiased
@@ -17,6 +18,10 @@ denoises the film's colour
 - with the albedo and the normal, denoised first, as clean guides (OIDN's
   cleanAux): what the display does ("guides, clean"), at each of OIDN's
   qualities (high, balanced: the display's, fast);
+- with the raw guides of a separate pass of 16 camera rays a pixel to
+  their first collision (another seed, --max-bounces 0: the feature pass
+  the command line had before the guides were gathered with the samples),
+  whose time is given beside the render's ("feature pass");
 
 and, for Auto's estimate, the even half with its own clean guides and with
 the whole film's: each one's error against the reference next to the
@@ -43,10 +48,9 @@ class Oidn:
     quality, kept, as the display keeps them."""
 
     def __init__(self):
-        import pyoidn
         from pyoidn.device import Device
-        from pyoidn.filter import Filter
-        self.pyoidn, self.Filter = pyoidn, Filter
+        from pyoidn.filter import OIDN_FORMAT_FLOAT3, Filter
+        self.Filter, self.float3 = Filter, OIDN_FORMAT_FLOAT3
         self.device = Device()
         self.device.commit()
         self.filters = {}
@@ -66,8 +70,8 @@ class Oidn:
         out = np.zeros_like(next(iter(inputs.values())), dtype=np.float32)
         kept = {name: np.ascontiguousarray(image, dtype=np.float32) for name, image in inputs.items()}
         for name, image in kept.items():
-            f.set_image(name, image)
-        f.set_image("output", out)
+            f.set_image(name, image, self.float3)
+        f.set_image("output", out, self.float3)
         f.commit()
         f.execute()
         return out
@@ -88,10 +92,22 @@ def estimate(denoised_half, a, b, n0, n):
     return max(0.0, terms.mean() + 2 * terms.std(ddof=1) / np.sqrt(terms.size))
 
 
+def feature_pass(name, size):
+    """The albedo and normal of 16 camera rays a pixel to their first
+    collision (another seed), and the seconds of that pass."""
+    with tempfile.TemporaryDirectory() as tmp:
+        prefix = os.path.join(tmp, "f")
+        r = acc.render(acc.SCENES[name]["args"], size, size, 16, seed=SEED + 1,
+                       extra=["--max-bounces", "0", "--output-denoiser-inputs", prefix])
+        return (acc.read_pfm(prefix + "_albedo.pfm").astype(np.float32),
+                acc.read_pfm(prefix + "_normal.pfm").astype(np.float32), r.seconds)
+
+
 def measure(name, counts, oidn):
     ref, ref_var, _ = acc.load_reference(name)
     size = ref.shape[0]
     error = lambda image: acc.relative_rmse(image, ref, ref_var)  # noqa: E731
+    feature_albedo, feature_normal, feature_seconds = feature_pass(name, size)
     rows = []
     for spp in counts:
         with tempfile.TemporaryDirectory() as tmp:
@@ -99,7 +115,10 @@ def measure(name, counts, oidn):
             extra = ["--shadow-scale", "1"] + (["--output-denoiser-inputs", prefix] if spp >= 2 else [])
             r = acc.render(acc.SCENES[name]["args"], size, size, spp, seed=SEED, extra=extra)
             film = r.mean.astype(np.float32)
-            row = {"spp": spp, "film": error(film), "colour": error(oidn.run({"color": film}))}
+            row = {"spp": spp, "seconds": r.seconds, "film": error(film), "colour": error(oidn.run({"color": film})),
+                   "feature pass": error(oidn.run({"color": film, "albedo": feature_albedo,
+                                                   "normal": feature_normal})),
+                   "feature pass seconds": feature_seconds}
             if spp >= 2:
                 read = lambda s: acc.read_pfm(f"{prefix}_{s}.pfm").astype(np.float32)  # noqa: E731
                 albedo, normal = read("albedo"), read("normal")
@@ -123,11 +142,14 @@ def measure(name, counts, oidn):
 
 
 def tables(results):
-    columns = ["film", "colour", "raw guides", "albedo, clean"] + ["guides, clean, " + q for q in QUALITIES]
-    lines = ["| scene | spp | " + " | ".join(columns) + " |", "|---|---|" + "---|" * len(columns)]
+    columns = ["film", "colour", "raw guides", "feature pass", "albedo, clean"] + [
+        "guides, clean, " + q for q in QUALITIES]
+    lines = ["| scene | spp (render s; feature pass s) | " + " | ".join(columns) + " |",
+             "|---|---|" + "---|" * len(columns)]
     for name, rows in results.items():
         for r in rows:
-            lines.append(f"| {acc.SCENES[name]['title']} | {r['spp']} | " +
+            lines.append(f"| {acc.SCENES[name]['title']} | {r['spp']} ({r['seconds']:.2f}; "
+                         f"{r['feature pass seconds']:.2f}) | " +
                          " | ".join(f"{r[c]:.4f}" if c in r else "" for c in columns) + " |")
     columns = ["half, own guides", "its estimate", "half, whole film's guides", "its estimate, whole"]
     lines += ["", "| scene | spp | " + " | ".join(columns) + " |", "|---|---|" + "---|" * len(columns)]
@@ -139,13 +161,46 @@ def tables(results):
     return "\n".join(lines)
 
 
+def timing(oidn, repeats=3):
+    """Seconds of one run of each filter the display runs (the filter kept,
+    the best of `repeats`), at 256 x 256, 512 x 512 and 1024 x 768, and what
+    a denoise and one with Auto's estimate add up to."""
+    import time
+    rng = np.random.default_rng(1)
+    print("| image | quality | colour alone | a guide | colour, clean guides | a denoise | with Auto's estimate |")
+    print("|---|---|---|---|---|---|---|")
+    for width, height in ((256, 256), (512, 512), (1024, 768)):
+        image = lambda: rng.random((height, width, 3), dtype=np.float32)  # noqa: E731
+        for quality in QUALITIES:
+            def best(inputs, clean=False):
+                oidn.run(inputs, quality, clean)  # the filter made and committed once
+                runs = []
+                for _ in range(repeats):
+                    start = time.perf_counter()
+                    oidn.run(inputs, quality, clean)
+                    runs.append(time.perf_counter() - start)
+                return min(runs)
+            colour = best({"color": image()})
+            guide = best({"albedo": image()})
+            guided = best({"color": image(), "albedo": image(), "normal": image()}, clean=True)
+            # A denoise: two guides, the colour with them, the coverage
+            # (colour alone); the estimate: the half's two guides and colour.
+            denoise = 2 * guide + guided + colour
+            print(f"| {width} x {height} | {quality} | {colour:.2f} s | {guide:.2f} s | {guided:.2f} s | "
+                  f"{denoise:.2f} s | {denoise + 2 * guide + guided:.2f} s |", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     parser.add_argument("--spp", nargs="*", type=int, default=[1, 2, 4, 8, 16, 32, 64])
     parser.add_argument("--json", help="write the figures here too")
+    parser.add_argument("--timing", action="store_true", help="only the filters' times")
     args = parser.parse_args()
     oidn = Oidn()
+    if args.timing:
+        timing(oidn)
+        return
     results = {name: measure(name, args.spp, oidn) for name in args.only or acc.SCENES}
     print(tables(results))
     if args.json:

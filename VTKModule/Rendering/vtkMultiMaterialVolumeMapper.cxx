@@ -738,7 +738,7 @@ bool vtkMultiMaterialVolumeMapper::IsConverged()
   // The image shown is final once no denoise is running or due.
   Internals& in = *this->Internal;
   return !(in.InFlight && in.InFlight->Denoising) &&
-    !in.Display.Due(in.FilmGeneration, film->Samples(), false);
+    !(this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, film->Samples(), false));
 }
 
 bool vtkMultiMaterialVolumeMapper::FilmConverged()
@@ -815,8 +815,10 @@ void vtkMultiMaterialVolumeMapper::GetDisplayedImage(vtkImageData* image)
   // What a frame drawn now would show of the film (previews are not kept).
   Internals& in = *this->Internal;
   const mmrtm::Film* film = this->ImageFilm();
+  if (film)
+    in.Display.Recheck(*film, in.FilmGeneration);
   const mmrtm::DenoisedFilm* denoised =
-    film ? in.Display.Shown(in.FilmGeneration, film->Samples()) : nullptr;
+    film && this->DenoisingApplies() ? in.Display.Shown(in.FilmGeneration, film->Samples()) : nullptr;
   if (!denoised)
   {
     this->GetAccumulatedImage(image);
@@ -1474,10 +1476,9 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   const int samples = this->FilmConverged() ? 0
     : this->MaximumSamples > 0            ? std::min(perRender, this->MaximumSamples - accumulated)
                                           : perRender;
-  if (samples > 0)
-    ++in.TracedPasses;
   const bool background = this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown;
-  if (background && in.Display.Due(in.FilmGeneration, in.Shown->Samples(), samples > 0) && this->DenoiserReady())
+  if (background && this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, in.Shown->Samples(), samples > 0) &&
+    this->DenoiserReady())
   {
     // A denoise of the image shown, before more samples: on the thread of
     // the passes, so that this render returns at once.
@@ -1488,8 +1489,6 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     const bool estimate = in.Display.WantsEstimate(in.FilmGeneration, in.Shown->Samples());
     mmrtm::Denoiser* denoiser = in.Denoiser.get();
     in.Display.Started();
-    if (samples > 0)
-      --in.TracedPasses; // no samples this time
     p->Thread = std::thread(
       [p, snapshot, estimate, denoiser]
       {
@@ -1506,6 +1505,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     in.InFlight = std::move(pass);
     return in.Shown.get();
   }
+  if (samples > 0)
+    ++in.TracedPasses;
   if (samples > 0 && background)
   {
     // The next pass on a thread of its own, under in.Built; this render
@@ -1535,7 +1536,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
   if (this->AsynchronousRefinement)
     in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
-  else if (in.Display.Due(in.FilmGeneration, in.Film->Samples(), !this->FilmConverged()) && this->DenoiserReady())
+  else if (this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, in.Film->Samples(), !this->FilmConverged()) &&
+    this->DenoiserReady())
   {
     // Synchronous refinement: the denoise after the pass, in this render.
     in.Display.Started();
@@ -1554,6 +1556,13 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   return in.Film.get();
 }
 
+bool vtkMultiMaterialVolumeMapper::DenoisingApplies()
+{
+  // A projection's one sample is its image: there is no noise to take out.
+  return this->DenoisingMode != DENOISING_OFF &&
+    this->Internal->Scene.render.integrator.projection.mode == mmrtm::IntensityProjection::None;
+}
+
 bool vtkMultiMaterialVolumeMapper::DenoiserReady()
 {
   Internals& in = *this->Internal;
@@ -1566,9 +1575,10 @@ bool vtkMultiMaterialVolumeMapper::DenoiserReady()
     }
     catch (const mmrtm::DenoiserError& e)
     {
-      // Said once; the status names it while a denoising mode is on.
-      in.Display.SetUnavailable("Intel Open Image Denoise not found");
-      vtkWarningMacro(<< e.what());
+      // Said once in full; the status names it while a denoising mode is on.
+      const std::string why = e.what();
+      in.Display.SetUnavailable(why.substr(0, why.find(" (")));
+      vtkWarningMacro(<< why);
     }
   }
   return in.Denoiser != nullptr;
@@ -1829,7 +1839,7 @@ double vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, 
   // Denoised on its colour alone, at OIDN's fast quality: one sample's
   // guides are as noisy as its colour, and the frame has a budget.
   in.PreviewDenoised.reset();
-  if (this->DenoisingMode != DENOISING_OFF && this->DenoiserReady())
+  if (this->DenoisingApplies() && this->DenoiserReady())
   {
     const auto denoiseStart = std::chrono::steady_clock::now();
     in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Fast);
@@ -1901,12 +1911,15 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
   else if (&film == this->ImageFilm())
   {
     in.LastShown = Internals::ShownImage::Film;
-    if (const mmrtm::DenoisedFilm* shown = in.Display.Shown(in.FilmGeneration, film.Samples()))
+    in.Display.Recheck(film, in.FilmGeneration);
+    const mmrtm::DenoisedFilm* shown =
+      this->DenoisingApplies() ? in.Display.Shown(in.FilmGeneration, film.Samples()) : nullptr;
+    if (shown)
     {
       denoised = &shown->image;
       denoisedAlpha = &shown->alpha;
     }
-    else if (this->DenoisingMode != DENOISING_OFF && in.PreviewDenoised && in.PreviewStandsFor == in.FilmGeneration &&
+    else if (this->DenoisingApplies() && in.PreviewDenoised && in.PreviewStandsFor == in.FilmGeneration &&
       !in.Display.HasDenoised(in.FilmGeneration))
     {
       denoised = &in.PreviewDenoised->image;

@@ -417,7 +417,9 @@ public:
    * previews are denoised too (colour only), and after one (the end of a
    * drag, a front end's preview of a change) the denoised preview stays
    * until the first denoised image of the new accumulation. Without the
-   * library the film is shown and GetDisplayStatus says why.
+   * library the film is shown and GetDisplayStatus says why. The
+   * projection blend modes are never denoised (their one sample is their
+   * image).
    */
   virtual void SetDenoisingMode(int mode);
   vtkGetMacro(DenoisingMode, int);
@@ -439,9 +441,10 @@ public:
   bool IsDenoisedImageShown();
 
   /**
-   * The image the last frame showed (the denoised one, or the accumulated
-   * film's), linear RGB and alpha as GetAccumulatedImage gives the film's;
-   * emptied when nothing was shown.
+   * What a frame drawn now would show of the accumulation: the denoised
+   * image or the film (GetAccumulatedImage), linear RGB and alpha as that
+   * gives the film's; emptied before the first sample. An interactive
+   * preview is not kept.
    */
   void GetDisplayedImage(vtkImageData* image);
 
@@ -682,8 +685,9 @@ private:
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();
   void FinishPass(bool cancel);
-  bool FilmConverged(); // the accumulation has reached MaximumSamples or NoiseTarget
-  bool DenoiserReady();  // loads it at the first call
+  bool FilmConverged();    // the accumulation has reached MaximumSamples or NoiseTarget
+  bool DenoisingApplies(); // a denoising mode, and noise to take out (not a projection)
+  bool DenoiserReady();    // loads it at the first call
   bool InputWillExecute();
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();

@@ -35,7 +35,8 @@ FilmSnapshot SnapshotFilm(const Film& film, uint64_t generation) {
   s.alpha.resize((size_t)film.Width() * film.Height());
   for (int y = 0; y < film.Height(); ++y)
     for (int x = 0; x < film.Width(); ++x) s.alpha[(size_t)y * film.Width() + x] = film.Alpha(x, y);
-  s.hasHalves = film.TracksDenoiserInputs() && film.Samples() >= 2;
+  s.tracksInputs = film.TracksDenoiserInputs();
+  s.hasHalves = s.tracksInputs && film.Samples() >= 2;
   if (s.hasHalves) s.halves = film.DenoiserImages();
   return s;
 }
@@ -53,25 +54,41 @@ double MeanSquaredDifference(const RGBImage& a, const RGBImage& b) {
   return a.pixels.empty() ? 0.0 : sum / (3.0 * a.pixels.size());
 }
 
-// The denoised half's error, MSE(D(A)) = E (D(A) - B)^2 - Var B, as its
-// estimate plus two standard errors (over pixels): at a few samples the
-// two terms are large and close, and their difference alone may even come
-// out below 0; the bound keeps Auto from taking that for a perfect image.
+// The mean of per-pixel terms plus two standard errors (over pixels), at
+// least 0: an estimate of a denoised image's error is a difference of two
+// terms that, at a few samples, are large and close, and alone it may even
+// come out below 0; the bound keeps Auto from taking that for a perfect
+// image.
+class ErrorBound {
+ public:
+  void Add(double t) {
+    sum_ += t;
+    sumSquares_ += t * t;
+    ++n_;
+  }
+  double Bound() const {
+    if (n_ < 2) return 0.0;
+    const double mean = sum_ / n_, variance = std::max(0.0, (sumSquares_ - sum_ * mean) / (n_ - 1));
+    return std::max(0.0, mean + 2.0 * std::sqrt(variance / n_));
+  }
+
+ private:
+  double sum_ = 0, sumSquares_ = 0;
+  int64_t n_ = 0;
+};
+
+// The denoised half's error, MSE(D(A)) = E (D(A) - B)^2 - Var B, bounded.
 double DenoisedHalfErrorBound(const RGBImage& denoisedA, const RGBImage& a, const RGBImage& b, double n0, double n) {
-  double sum = 0, sumSquares = 0;
-  const size_t pixels = a.pixels.size();
-  for (size_t i = 0; i < pixels; ++i) {
+  ErrorBound bound;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
     double t = 0;
     for (int c = 0; c < 3; ++c) {
       const double d = (double)denoisedA.pixels[i][c] - b.pixels[i][c], h = (double)a.pixels[i][c] - b.pixels[i][c];
       t += (d * d - h * h * (Planted(Defect::DenoiseVariance) ? 1.0 : n0 / n)) / 3.0;
     }
-    sum += t;
-    sumSquares += t * t;
+    bound.Add(t);
   }
-  if (pixels < 2) return 0.0;
-  const double mean = sum / pixels, variance = std::max(0.0, (sumSquares - sum * mean) / (pixels - 1));
-  return std::max(0.0, mean + 2.0 * std::sqrt(variance / pixels));
+  return bound.Bound();
 }
 
 }  // namespace
@@ -82,6 +99,12 @@ std::optional<DenoisedFilm> DenoiseSnapshot(const FilmSnapshot& s, bool estimate
   DenoisedFilm out;
   out.generation = s.generation;
   out.samples = s.samples;
+  if (s.hasHalves) {
+    out.filmMean = s.color;
+    out.filmEvenMean = s.halves.color[0];
+  } else if (s.samples == 1 && s.tracksInputs) {
+    out.filmMean = out.filmEvenMean = s.color;  // its one sample is its even half
+  }
   // The coverage is denoised as the colour is (a grey image): at a few
   // samples the coverage of translucent matter is as noisy as its colour,
   // and the background would show through it in specks.
@@ -138,6 +161,49 @@ DenoiseFunction OidnDenoise(Denoiser& denoiser) {
   };
 }
 
+void DenoisedDisplay::Recheck(const Film& film, uint64_t generation) {
+  const uint32_t n = film.Samples();
+  if (mode_ != DenoisingMode::Auto || !last_ || generation != generation_ || settledOnFilm_ || n == rechecked_ ||
+      film.Adaptive() || !film.TracksDenoiserInputs() || last_->filmEvenMean.pixels.empty() ||
+      last_->filmMean.width != film.Width() || last_->filmMean.height != film.Height())
+    return;
+  const uint32_t m = last_->samples, n0 = (n + 1) / 2, m0 = (m + 1) / 2;
+  if (n <= m || n0 <= m0 || n - n0 <= m - m0) return;  // new samples in both halves
+  rechecked_ = n;
+  // The samples since the denoise: their sum is n F_n - m F_m (even ones:
+  // n0 A_n - m0 A_m), their mean F' an unbiased estimate independent of
+  // the denoised image D, and E (D - F')^2 = MSE(D) + Var F', Var F' from
+  // their own halves' difference. The film's error from its halves.
+  const double k = n - m, k0 = n0 - m0, k1 = k - k0, n1 = n - n0;
+  const RGBImage& image = last_->image;
+  ErrorBound denoised;
+  double filmError = 0, sum = 0;
+  for (int y = 0; y < film.Height(); ++y)
+    for (int x = 0; x < film.Width(); ++x) {
+      const size_t i = (size_t)y * film.Width() + x;
+      const RGB f = film.Mean(x, y), a = film.EvenMean(x, y), fm = last_->filmMean.pixels[i],
+                am = last_->filmEvenMean.pixels[i];
+      double t = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double all = (double)n * f[c] - (double)m * fm[c], even = (double)n0 * a[c] - (double)m0 * am[c];
+        const double mean = all / k, evenMean = even / k0, oddMean = (all - even) / k1;
+        const double d = (double)image.pixels[i][c] - mean, h = evenMean - oddMean;
+        t += (d * d - h * h * k0 * k1 / (k * k)) / 3.0;
+        const double b = ((double)n * f[c] - (double)n0 * a[c]) / n1, filmH = a[c] - b;
+        filmError += filmH * filmH * n0 * n1 / ((double)n * n) / 3.0;
+        sum += f[c] / 3.0;
+      }
+      denoised.Add(t);
+    }
+  const double pixels = (double)film.Width() * film.Height();
+  DenoiseEstimate e;
+  e.samples = n;
+  e.denoised = denoised.Bound();
+  e.film = filmError / pixels;
+  e.meanValue = sum / pixels;
+  estimate_ = e;
+}
+
 bool DenoisedDisplay::Due(uint64_t generation, uint32_t samples, bool accumulating, Clock::time_point now) const {
   if (mode_ == DenoisingMode::Off || busy_ || samples == 0 || !unavailable_.empty()) return false;
   if (generation != generation_ || !last_) return true;  // a new accumulation: at once
@@ -168,11 +234,14 @@ void DenoisedDisplay::Finished(std::optional<DenoisedFilm> result, Clock::time_p
     settledOnFilm_ = !estimate_->DenoisedCloserAt(estimate_->samples);
   }
   last_ = std::move(result);
+  rechecked_ = 0;
 }
 
 const DenoisedFilm* DenoisedDisplay::Shown(uint64_t generation, uint32_t samples) const {
   if (mode_ == DenoisingMode::Off || !last_ || generation != generation_ || samples == 0) return nullptr;
-  return mode_ == DenoisingMode::Auto && settledOnFilm_ ? nullptr : &*last_;
+  if (mode_ == DenoisingMode::Always) return &*last_;
+  if (settledOnFilm_) return nullptr;
+  return !estimate_ || estimate_->DenoisedCloserAt(samples) ? &*last_ : nullptr;
 }
 
 const DenoiseEstimate* DenoisedDisplay::Estimate(uint64_t generation) const {

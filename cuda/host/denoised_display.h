@@ -13,9 +13,11 @@
 // Var B); the estimate plus two of its standard errors is the bound used.
 // The whole film's denoised image D(F) has twice A's samples: its error is
 // taken to be at most D(A)'s (a denoiser whose error grew with samples
-// would break this; Testing/Accuracy/denoised_display.py checks it on the
-// reference scenes). The film's own error is its variance, from the same
-// difference. Host-only.
+// would break this; TestDenoisedDisplay checks it on the reference
+// scenes). The film's own error is its variance, from the same difference.
+// As the film goes on, the denoised image is checked again against the
+// samples that came after it (Recheck): they are independent of it, so
+// the same reasoning holds with them in B's place. Host-only.
 #pragma once
 
 #include <atomic>
@@ -42,7 +44,8 @@ struct FilmSnapshot {
   uint32_t samples = 0;
   RGBImage color;            // the film's mean
   std::vector<float> alpha;  // its coverage
-  bool hasHalves = false;    // the film kept its denoiser inputs and has 2 or more samples
+  bool tracksInputs = false;  // the film kept its denoiser inputs
+  bool hasHalves = false;     // and has 2 or more samples
   FilmHalves halves;
 };
 FilmSnapshot SnapshotFilm(const Film& film, uint64_t generation);
@@ -61,12 +64,13 @@ using DenoiseFunction = std::function<std::vector<RGBImage>(
 // only).
 DenoiseFunction OidnDenoise(Denoiser& denoiser);
 
-// How far a film of `samples` samples and its denoised image are from the
-// truth: means over pixels and channels of the squared difference, in
-// linear radiance (relative figures divide their roots by meanValue).
+// How far the film, when it had `samples` samples, and the denoised image
+// shown are from the truth: means over pixels and channels of the squared
+// difference, in linear radiance (relative figures divide their roots by
+// meanValue).
 struct DenoiseEstimate {
   uint32_t samples = 0;
-  double denoised = 0;   // the denoised half's, plus two standard errors: a bound of the denoised film's
+  double denoised = 0;   // an estimate plus two standard errors: a bound of the denoised image's
   double film = 0;       // the film's (its variance)
   double meanValue = 0;  // the film's mean over pixels and channels
   // The film's error once it has `n` samples (variance goes as 1 / n).
@@ -76,7 +80,9 @@ struct DenoiseEstimate {
 };
 
 // A film denoised: the image, the film's coverage with it, and the
-// estimate when one was made.
+// estimate when one was made; and the film as it was denoised (its mean
+// and the mean of its even samples), which Recheck subtracts from the film
+// as it is later to find the samples that came after.
 struct DenoisedFilm {
   uint64_t generation = 0;
   uint32_t samples = 0;
@@ -84,6 +90,7 @@ struct DenoisedFilm {
   std::vector<float> alpha;
   std::optional<DenoiseEstimate> estimate;
   double seconds = 0;  // the denoiser's time, the estimate's included
+  RGBImage filmMean, filmEvenMean;  // empty when the film kept no denoiser inputs
 };
 
 // Denoises the snapshot's colour; with `estimate` and halves also the half
@@ -122,15 +129,19 @@ class DenoisedDisplay {
   }
   void Finished(std::optional<DenoisedFilm> result, Clock::time_point now = Clock::now());
 
+  // Auto: the newest denoised image of `film` (the accumulation
+  // `generation`) checked against the samples the film gained since it was
+  // made, when there are new samples in both halves (the header's
+  // reasoning); the result is the latest estimate. Checked once per sample
+  // count; nothing for an adaptive film or one without denoiser inputs.
+  void Recheck(const Film& film, uint64_t generation);
+
   // The image to draw over the film of `generation` with `samples`: the
-  // newest denoised one, or null for the film itself. Auto shows it until
-  // an estimate finds the film closer, and the film from then on: a
-  // denoise of one sample needs none (there are no halves to estimate by,
-  // and a one-sample film was the farther on every reference scene:
-  // Documentation/denoising.md); an estimate whose bound the film has
-  // caught up with asks for a fresh one (WantsEstimate) and stands until
-  // it comes, so that the view does not fall back to the noisier film for
-  // the time between two denoises.
+  // newest denoised one, or null for the film itself. Auto shows it while
+  // the latest estimate says it is closer (a denoise of one sample needs
+  // none: there are no halves to estimate by, and a one-sample film was the
+  // farther on every reference scene: Documentation/denoising.md), and the
+  // film once a denoise's own estimate finds the film closer.
   const DenoisedFilm* Shown(uint64_t generation, uint32_t samples) const;
 
   // "denoised, 8 samples", "unbiased, 64 samples, noise 2.1 %" (noise:
@@ -153,8 +164,9 @@ class DenoisedDisplay {
   DenoisingMode mode_ = DenoisingMode::Off;
   uint64_t generation_ = 0;            // the newest accumulation a denoise was of
   std::optional<DenoisedFilm> last_;   // its latest denoised image
-  std::optional<DenoiseEstimate> estimate_;  // its latest estimate
-  bool settledOnFilm_ = false;         // Auto: an estimate found the film closer
+  std::optional<DenoiseEstimate> estimate_;  // its latest estimate (of a denoise or a Recheck)
+  bool settledOnFilm_ = false;         // Auto: a denoise's estimate found the film closer
+  uint32_t rechecked_ = 0;             // the sample count of the last Recheck
   bool busy_ = false;                  // between Started and Finished
   Clock::time_point finished_{};
   Clock::time_point started_{};

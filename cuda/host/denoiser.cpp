@@ -99,9 +99,16 @@ std::unique_ptr<Denoiser> Denoiser::Load(int threads) {
   }
   if (!api->library)
     throw DenoiserError(
-        "Intel Open Image Denoise not found (scripts/install-dependencies.sh installs the `oidn` "
-        "wheel into .venv; MMRTM_OIDN_LIBRARY names a library). Tried:" +
+        "Intel Open Image Denoise not found (scripts/install-dependencies.sh installs the `pyoidn` "
+        "wheel into .venv, pip install mmrtm[denoise] with the Python package; MMRTM_OIDN_LIBRARY names a "
+        "library). Tried:" +
         tried);
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // Its TBB opens libtbbbind with RTLD_DEEPBIND when the device starts,
+  // which the sanitizer runtimes refuse by ending the process.
+  throw DenoiserError("Intel Open Image Denoise is not started in a build with sanitizers (" + path +
+                      ": its TBB opens libraries with RTLD_DEEPBIND, which the sanitizer runtimes refuse)");
+#endif
   Api& a = *api;
   Bind(a.library, "oidnNewDevice", &a.newDevice, path);
   Bind(a.library, "oidnSetDeviceInt", &a.setDeviceInt, path, "oidnSetDevice1i");

@@ -51,6 +51,12 @@ RGB Film::Mean(int x, int y) const {
   return RGB(m[0], m[1], m[2]);
 }
 
+RGB Film::EvenMean(int x, int y) const {
+  if (denoiserInputs_.empty()) return RGB(0.f);
+  const float* d = &denoiserInputs_[FilmView::kDenoiserInputFloats * ((size_t)y * width_ + x) + FilmView::kEvenRGB];
+  return RGB(d[0], d[1], d[2]);
+}
+
 RGB Film::VarianceOfMean(int x, int y) const {
   const uint32_t n = PixelSamples(x, y);
   if (n < 2) return RGB(0.f);

@@ -88,6 +88,9 @@ class Film {
   FilmHalves DenoiserImages() const;
 
   RGB Mean(int x, int y) const;
+  // The mean of the pixel's even samples (0, 2, 4 ...), kept with the
+  // denoiser's inputs (black without them).
+  RGB EvenMean(int x, int y) const;
   float Alpha(int x, int y) const { return mean_[4 * ((size_t)y * width_ + x) + 3]; }
   // Variance of the pixel's mean estimate, per channel, from the samples'
   // spread (0 before 2 samples): exact in expectation for independent

@@ -380,6 +380,8 @@ class TestMmrtmViewer : public QObject {
     QVERIFY(v.window.openVolume(Data("ct_head_cranium.nrrd")));
     vtkMultiMaterialVolumeMapper* m = v.window.scene().Mapper();
     QVERIFY(RefineTo(v.window, 8));
+    if (QString::fromUtf8(m->GetDisplayStatus()).contains("not denoised"))
+      QSKIP(m->GetDisplayStatus());  // no denoiser here (a build with sanitizers does not start it)
     // Auto at 8 samples: the denoised image, once its last denoise is drawn.
     QTRY_VERIFY_WITH_TIMEOUT(m->IsConverged() && v.window.statusLine()->text().contains("shown: denoised, 8 samples"),
                              30000);

@@ -116,7 +116,7 @@ class WebViewer:
         state.samples_per_render, state.maximum_samples, state.noise_target = 4, maximum_samples, 0.0
         state.samples, state.noise, state.refining, state.frames = 0, 0.0, False, 0
         state.displays, state.display = list(DISPLAYS), DEFAULT_DISPLAY
-        state.display_status, state.denoises = "", 0
+        state.display_status, state.denoises, state.denoise_seconds = "", 0, 0.0
         state.opacity_points, state.colour_points = [], []
         state.segmentation_path = ""
         state.segments = []
@@ -384,6 +384,7 @@ class WebViewer:
             state.refining = not mapper.IsConverged()
             state.display_status = mapper.GetDisplayStatus()
             state.denoises = mapper.GetNumberOfDenoises()
+            state.denoise_seconds = round(mapper.GetDenoisingSeconds(), 1)
 
     def screenshot_png(self):
         """The 3D view as it is now, as PNG bytes (lossless, unlike the

@@ -31,7 +31,11 @@ def build_page(server, layouts):
                       " {{ refining ? '(refining)' : samples ? '(converged)' : '(starting)' }}",
                       v_if=("method.startsWith('Path')",), classes="refinement-status text-body-2 mr-2")
             html.Span("shown: {{ display_status }}", v_if=("method.startsWith('Path') && display_status",),
-                      classes="display-status text-body-2 mr-4")
+                      classes="display-status text-body-2 mr-2")
+            # The denoiser's time since the server started (at most a
+            # quarter of the refinement's).
+            html.Span("denoiser {{ denoise_seconds }} s", v_if=("method.startsWith('Path') && denoises",),
+                      classes="denoise-seconds text-caption mr-4")
             html.Span("{{ denoises }}", classes="denoise-count d-none")
             # Frames rendered since the server started: the browser test
             # compares it with the frames it received and the passes.
