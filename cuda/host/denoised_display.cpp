@@ -163,12 +163,16 @@ DenoiseFunction OidnDenoise(Denoiser& denoiser) {
 
 void DenoisedDisplay::Recheck(const Film& film, uint64_t generation) {
   const uint32_t n = film.Samples();
-  if (mode_ != DenoisingMode::Auto || !last_ || generation != generation_ || settledOnFilm_ || n == rechecked_ ||
-      film.Adaptive() || !film.TracksDenoiserInputs() || last_->filmEvenMean.pixels.empty() ||
+  if (mode_ != DenoisingMode::Auto || !last_ || generation != generation_ || settledOnFilm_ || film.Adaptive() ||
+      !film.TracksDenoiserInputs() || last_->filmEvenMean.pixels.empty() ||
       last_->filmMean.width != film.Width() || last_->filmMean.height != film.Height())
     return;
   const uint32_t m = last_->samples, n0 = (n + 1) / 2, m0 = (m + 1) / 2;
   if (n <= m || n0 <= m0 || n - n0 <= m - m0) return;  // new samples in both halves
+  // Each time the new samples have doubled: a check of a few new samples is
+  // loose (their noise is most of the difference), and the bound kept is
+  // the tightest so far, which many checks in a row would bias low.
+  if (rechecked_ && n - m < 2 * (rechecked_ - m)) return;
   rechecked_ = n;
   // The samples since the denoise: their sum is n F_n - m F_m (even ones:
   // n0 A_n - m0 A_m), their mean F' an unbiased estimate independent of
@@ -198,7 +202,9 @@ void DenoisedDisplay::Recheck(const Film& film, uint64_t generation) {
   const double pixels = (double)film.Width() * film.Height();
   DenoiseEstimate e;
   e.samples = n;
-  e.denoised = denoised.Bound();
+  // Both are bounds of this image's error (an earlier one by the denoiser's
+  // error not growing with samples): the tighter holds.
+  e.denoised = estimate_ ? std::min(estimate_->denoised, denoised.Bound()) : denoised.Bound();
   e.film = filmError / pixels;
   e.meanValue = sum / pixels;
   estimate_ = e;

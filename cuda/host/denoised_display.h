@@ -131,9 +131,10 @@ class DenoisedDisplay {
 
   // Auto: the newest denoised image of `film` (the accumulation
   // `generation`) checked against the samples the film gained since it was
-  // made, when there are new samples in both halves (the header's
-  // reasoning); the result is the latest estimate. Checked once per sample
-  // count; nothing for an adaptive film or one without denoiser inputs.
+  // made (the header's reasoning), each time they have doubled, when there
+  // are new samples in both halves; the latest estimate then holds the
+  // film's error now and the tightest bound of the image's. Nothing for an
+  // adaptive film or one without denoiser inputs.
   void Recheck(const Film& film, uint64_t generation);
 
   // The image to draw over the film of `generation` with `samples`: the
