@@ -485,6 +485,7 @@ int Run(const Options& o) {
   CheckWritable(o.outputVariance);
   CheckWritable(o.statsJson);
   CheckWritable(o.denoisedPreview);
+  if (!o.outputDenoiserInputs.empty()) CheckWritable(o.outputDenoiserInputs + "_albedo.pfm");
   // Found before a long render, or the denoising fails at the end.
   std::unique_ptr<mmrtm::Denoiser> denoiser;
   if (!o.denoisedPreview.empty() || o.denoise != mmrtm::DenoisingMode::Off)
@@ -547,6 +548,8 @@ int Run(const Options& o) {
   const auto note = [&](const std::string& text) {
     if (!o.quiet) std::fprintf(stderr, "note: %s\n", text.c_str());
   };
+  if (!o.outputDenoiserInputs.empty() && rs.samplesPerPixel < 2)
+    throw mmrtm::InputError("--output-denoiser-inputs needs 2 or more samples per pixel (the even and odd halves)");
   std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note, o.simd);
   mmrtm::Film film(rs.width, rs.height);
   if (denoiser || !o.outputDenoiserInputs.empty()) film.TrackDenoiserInputs();

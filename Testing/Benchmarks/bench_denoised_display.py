@@ -218,6 +218,20 @@ def measure_drag(size, frames=12):
     return results
 
 
+def table(results):
+    """Markdown: per scene and display, at each mark the samples, what was
+    shown (D denoised, U the film) and its error; the denoiser's share."""
+    lines = ["| scene | display | " + " | ".join("%g s" % m for m in MARKS) + " | denoising |",
+             "|---|---|" + "---|" * len(MARKS) + "---|"]
+    for name, rows in results.items():
+        for mode, row in rows.items():
+            cells = ["%d spp, %s %.3f" % (k["samples"], "D" if k["denoised"] else "U", k["rel_rmse"])
+                     if k["samples"] else "(no frame yet)" for k in row["marks"]]
+            lines.append("| %s | %s | %s | %.1f s (%d runs) |" % (name, mode, " | ".join(cells),
+                                                                  row["denoise_seconds"], row["denoises"]))
+    return "\n".join(lines)
+
+
 def chart(results, path):
     """Error against time, a panel a scene (results as --json writes them)."""
     import matplotlib
@@ -257,7 +271,9 @@ def main():
     args = parser.parse_args()
     if args.chart:
         with open(args.chart[0]) as f:
-            chart(json.load(f)["scenes"], args.chart[1])
+            scenes = json.load(f)["scenes"]
+        chart(scenes, args.chart[1])
+        print(table(scenes))
         return
     scenes = reference_scenes()
     results = {}

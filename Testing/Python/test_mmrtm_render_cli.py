@@ -253,6 +253,8 @@ class RenderCli(unittest.TestCase):
                             code=2)
         self.expect_failure(self.run_render(HEADSQ, "--denoised-preview", os.path.join(self.dir, "p.exr")),
                             "--denoised-preview expects a .png or .pfm", code=2)
+        self.expect_failure(self.run_render(HEADSQ, "--spp", "1", "--output-denoiser-inputs",
+                                            os.path.join(self.dir, "inputs")), "needs 2 or more samples")
         if os.environ.get("MMRTM_SANITIZED"):
             self.skipTest("Open Image Denoise under sanitizers: its TBB dlopens with RTLD_DEEPBIND, which the "
                           "sanitizer runtime refuses (the Release build runs this test)")
@@ -293,6 +295,20 @@ class RenderCli(unittest.TestCase):
         rmse = lambda a: (sum((x - y) ** 2 for x, y in zip(a, ref)) / len(ref)) ** 0.5  # noqa: E731
         self.assertLess(rmse(denoised), 0.4 * rmse(raw), (rmse(denoised), rmse(raw)))
         self.assertAlmostEqual(sum(denoised) / sum(ref), 1.0, delta=0.03)
+        # The denoiser's inputs: the even and the odd half average to the
+        # film; the guides are written beside them.
+        prefix = os.path.join(self.dir, "inputs")
+        _, film = self.render_linear("inputs", "--spp", "4", "--output-denoiser-inputs", prefix)
+        halves = []
+        for name in ("color_even", "color_odd"):
+            with open("%s_%s.pfm" % (prefix, name), "rb") as f:
+                halves.append(read_pfm_pixels(f.read()))
+        film = read_pfm_pixels(film)
+        self.assertEqual(len(halves[0]), len(film))
+        self.assertLess(max(abs((a + b) / 2 - c) for a, b, c in zip(*halves, film)), 1e-4)
+        self.assertNotEqual(halves[0], halves[1])
+        for name in ("albedo", "normal", "albedo_even", "albedo_odd", "normal_even", "normal_odd"):
+            self.assertTrue(os.path.exists("%s_%s.pfm" % (prefix, name)), name)
         # --denoise always writes the denoised image as --output.
         shown = os.path.join(self.dir, "shown.png")
         r = subprocess.run([RENDER, HEADSQ, *size, "--spp", "2", "--denoise", "always", "--denoised-preview", png,
