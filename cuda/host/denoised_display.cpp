@@ -120,7 +120,7 @@ std::optional<DenoisedFilm> DenoiseSnapshot(const FilmSnapshot& s, bool estimate
   if (estimate && s.hasHalves) {
     // D(A) against B (the header's reasoning), A denoised with its own
     // guides: the whole film's know where B's camera rays first collided,
-    // which made the estimate 10-20 % low on the bonsai and the CTA
+    // which made the estimate 5-8 % low on the bonsai
     // (Documentation/denoising.md). The halves' variances from their
     // difference: E (A - B)^2 = Var A + Var B, each going as 1 / its
     // samples.

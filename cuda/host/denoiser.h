@@ -27,10 +27,10 @@ class DenoiserError : public std::runtime_error {
 
 class Denoiser {
  public:
-  // OIDN 2's filter quality (1.4 has one, about Balanced's): Balanced,
-  // the default, as good as 1.4 at its speed; Fast twice as fast and 2-8 %
-  // farther from the truth; High 3-6 % closer, 2.3 times slower with clean
-  // guides (Documentation/denoising.md).
+  // OIDN 2's filter quality (1.4 has one, about Balanced's): Balanced, the
+  // default; Fast, faster and a little farther from the truth; High, a
+  // little closer and much slower with clean guides (the figures:
+  // Documentation/denoising.md).
   enum class Quality { High, Balanced, Fast };
 
   // Loads the library and makes a device with `threads` threads (0: OIDN's
