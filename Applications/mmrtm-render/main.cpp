@@ -137,9 +137,8 @@ json MemoryJson(const mmrtm::Scene& scene, const mmrtm::SceneView& view, size_t 
 }
 
 struct Options {
-  std::string input, scene, preset, labels, labelTable, series, output = "mmrtm-render.png", outputLinear,
-                                                                outputVariance, statsJson, denoisedPreview,
-                                                                outputDenoiserInputs;
+  std::string input, scene, preset, labels, labelTable, series,
+      output = "mmrtm-render.png", outputLinear, outputVariance, statsJson, denoisedPreview, outputDenoiserInputs;
   mmrtm::DenoisingMode denoise = mmrtm::DenoisingMode::Off;
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
@@ -439,8 +438,8 @@ json DenoiseFilm(const Options& o, mmrtm::Denoiser& denoiser, const mmrtm::Film&
   display.SetMode(o.denoise == mmrtm::DenoisingMode::Off ? mmrtm::DenoisingMode::Always : o.denoise);
   display.Started();
   const mmrtm::FilmSnapshot snapshot = mmrtm::SnapshotFilm(film, 0);
-  *denoised = mmrtm::DenoiseSnapshot(snapshot, display.WantsEstimate(0, film.Samples()), true,
-                                     mmrtm::OidnDenoise(denoiser));
+  *denoised =
+      mmrtm::DenoiseSnapshot(snapshot, display.WantsEstimate(0, film.Samples()), true, mmrtm::OidnDenoise(denoiser));
   display.Finished(*denoised);
   *shown = o.denoise != mmrtm::DenoisingMode::Off && display.Shown(0, film.Samples()) != nullptr;
   if (!o.denoisedPreview.empty()) {

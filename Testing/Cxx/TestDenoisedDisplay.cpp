@@ -43,8 +43,8 @@ DenoiseEstimate Estimate(uint32_t samples, double denoised, double film) {
 // Runs one denoise of `seconds` through the display, as its owner does.
 void RunDenoise(DenoisedDisplay& display, Clock::time_point start, double seconds, std::optional<DenoisedFilm> result) {
   display.Started(start);
-  display.Finished(std::move(result), start + std::chrono::duration_cast<Clock::duration>(
-                                                   std::chrono::duration<double>(seconds)));
+  display.Finished(std::move(result),
+                   start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds)));
 }
 
 TEST(DenoisedDisplay, OffShowsTheFilmAndDenoisesNothing) {
@@ -123,7 +123,8 @@ TEST(DenoisedDisplay, StatusSaysWhyNothingIsDenoised) {
   display.SetMode(DenoisingMode::Auto);
   display.SetUnavailable("Intel Open Image Denoise not found");
   EXPECT_FALSE(display.Due(1, 4, true));
-  EXPECT_EQ(display.Status(1, 4, 0.05), "unbiased, 4 samples, noise 5.0 % (not denoised: Intel Open Image Denoise not found)");
+  EXPECT_EQ(display.Status(1, 4, 0.05),
+            "unbiased, 4 samples, noise 5.0 % (not denoised: Intel Open Image Denoise not found)");
   EXPECT_EQ(display.Status(1, 0, 0.0), "no samples yet");
 }
 
@@ -168,8 +169,7 @@ KnownHalves MakeKnownHalves(uint32_t n0, uint32_t n1, double sigma, uint32_t see
 
 // A denoiser that returns `f` of each colour image (no guides here).
 DenoiseFunction Fake(std::function<RGBImage(const RGBImage&)> f) {
-  return [f](const std::vector<const RGBImage*>& colors, const RGBImage*, const RGBImage*,
-             const std::atomic<bool>*) {
+  return [f](const std::vector<const RGBImage*>& colors, const RGBImage*, const RGBImage*, const std::atomic<bool>*) {
     std::vector<RGBImage> out;
     for (const RGBImage* c : colors) out.push_back(f(*c));
     return out;
@@ -242,7 +242,8 @@ double RelativeError(const RGBImage& image, const Film& reference) {
   double squared = 0, variance = 0, sum = 0;
   for (int y = 0; y < reference.Height(); ++y)
     for (int x = 0; x < reference.Width(); ++x) {
-      const RGB r = reference.Mean(x, y), v = reference.VarianceOfMean(x, y), p = image.pixels[(size_t)y * reference.Width() + x];
+      const RGB r = reference.Mean(x, y), v = reference.VarianceOfMean(x, y),
+                p = image.pixels[(size_t)y * reference.Width() + x];
       for (int c = 0; c < 3; ++c) {
         squared += ((double)p[c] - r[c]) * ((double)p[c] - r[c]);
         variance += v[c];
@@ -317,7 +318,7 @@ TEST(DenoisedDisplay, ChecksTheDenoisedImageAgainstTheSamplesThatCameAfter) {
   ASSERT_NE(display.Estimate(1), nullptr);
   EXPECT_NEAR(display.Estimate(1)->film, 0.04 / 8, 0.05 * 0.04 / 8);
   EXPECT_NEAR(display.Estimate(1)->denoised, shift, 0.25 * shift) << "the 4 new samples' noise, 0.01 a pixel, "
-                                                                      "taken out of a difference of 0.0123";
+                                                                     "taken out of a difference of 0.0123";
   EXPECT_NE(display.Shown(1, 8), nullptr);
   AddKnownSamples(film, small, 8, 64, 0.2, rng);
   display.Recheck(film, 1);
@@ -334,8 +335,9 @@ TEST_F(DenoisedDisplayOnReferenceScenes, AutoNeverShowsAnImageFartherThanTheFilm
   const DenoiseFunction oidn = OidnDenoise(*denoiser_);
   const std::vector<std::pair<std::string, DenoiseFunction>> denoisers = {
       {"OIDN", oidn},
-      {"blur", [&](const std::vector<const RGBImage*>& colors, const RGBImage* a, const RGBImage* n,
-                   const std::atomic<bool>* cancel) {
+      {"blur",
+       [&](const std::vector<const RGBImage*>& colors, const RGBImage* a, const RGBImage* n,
+           const std::atomic<bool>* cancel) {
          std::vector<RGBImage> out = oidn(colors, a, n, cancel);
          for (RGBImage& image : out) image = BoxBlur(image, 4);
          return out;
@@ -378,8 +380,8 @@ TEST_F(DenoisedDisplayOnReferenceScenes, AutoNeverShowsAnImageFartherThanTheFilm
         (shown ? shownDenoised : shownFilm)++;
         std::printf("%-13s %3u spp  %-12s film %.4f  denoised %.4f  shown %s\n", name.c_str(), spp, label.c_str(),
                     filmError, denoisedError, shown ? "denoised" : "film");
-        EXPECT_LE(displayed, 1.05 * filmError) << name << ", " << spp << " spp, " << label << ": shows the "
-                                               << (shown ? "denoised image" : "film");
+        EXPECT_LE(displayed, 1.05 * filmError)
+            << name << ", " << spp << " spp, " << label << ": shows the " << (shown ? "denoised image" : "film");
         if (name == "head_ct_bone" && spp == 4 && label == "OIDN")
           EXPECT_TRUE(shown && denoisedError < 0.5 * filmError) << "a few samples of the head CT: denoised, closer";
       }

@@ -106,8 +106,7 @@ TEST(DenoiserInputs, TheHalvesAreTheEvenAndTheOddSamples) {
       for (int c = 0; c < 3; ++c) {
         // The running means: sample n alone is n m_n - (n - 1) m_(n-1).
         auto sample = [&](int n) {
-          return n == 0 ? single[0].Mean(x, y)[c]
-                        : (n + 1) * single[n].Mean(x, y)[c] - n * single[n - 1].Mean(x, y)[c];
+          return n == 0 ? single[0].Mean(x, y)[c] : (n + 1) * single[n].Mean(x, y)[c] - n * single[n - 1].Mean(x, y)[c];
         };
         const float even = (sample(0) + sample(2) + sample(4)) / 3.f, odd = (sample(1) + sample(3)) / 2.f;
         const size_t i = (size_t)y * 16 + x;

@@ -230,7 +230,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::unique_ptr<mmrtm::Denoiser> Denoiser; // loaded at the first need
   bool DenoiserLoadTried = false;
   std::optional<mmrtm::DenoisedFilm> PreviewDenoised; // the interactive preview, when denoised
-  uint64_t PreviewStandsFor = 0;                       // the accumulation it stands for (RenderFrame), or 0
+  uint64_t PreviewStandsFor = 0;                      // the accumulation it stands for (RenderFrame), or 0
   double PreviewDenoiseSeconds = 0;
   int PreviewDenoises = 0;
   // What the last frame drew: the mapper's film (or the copy of it that
@@ -1474,8 +1474,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
     : in.Built.View.Tile && in.ParkedFilm ? std::max(this->SamplesPerRender, static_cast<int>(in.ParkedFilm->Samples()))
                                           : this->SamplesPerRender;
   const int samples = this->FilmConverged() ? 0
-    : this->MaximumSamples > 0            ? std::min(perRender, this->MaximumSamples - accumulated)
-                                          : perRender;
+    : this->MaximumSamples > 0              ? std::min(perRender, this->MaximumSamples - accumulated)
+                                            : perRender;
   const bool background = this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown;
   if (background && this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, in.Shown->Samples(), samples > 0) &&
     this->DenoiserReady())
@@ -1845,16 +1845,15 @@ double vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, 
     in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Fast);
     try
     {
-      in.PreviewDenoised = mmrtm::DenoiseSnapshot(
-        mmrtm::SnapshotFilm(*in.Preview, 0), false, false, mmrtm::OidnDenoise(*in.Denoiser));
+      in.PreviewDenoised =
+        mmrtm::DenoiseSnapshot(mmrtm::SnapshotFilm(*in.Preview, 0), false, false, mmrtm::OidnDenoise(*in.Denoiser));
     }
     catch (const mmrtm::DenoiserError& e)
     {
       vtkErrorMacro("Render: the denoiser failed: " << e.what());
     }
     in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Balanced);
-    in.PreviewDenoiseSeconds +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - denoiseStart).count();
+    in.PreviewDenoiseSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - denoiseStart).count();
     ++in.PreviewDenoises;
   }
   // The still render after the interaction starts again at full resolution.

@@ -125,8 +125,8 @@ std::optional<DenoisedFilm> DenoiseSnapshot(const FilmSnapshot& s, bool estimate
     // difference: E (A - B)^2 = Var A + Var B, each going as 1 / its
     // samples.
     const FilmHalves& h = s.halves;
-    const std::vector<RGBImage> half = denoise({&h.color[0]}, guided ? &h.albedo[0] : nullptr,
-                                               guided ? &h.normal[0] : nullptr, cancel);
+    const std::vector<RGBImage> half =
+        denoise({&h.color[0]}, guided ? &h.albedo[0] : nullptr, guided ? &h.normal[0] : nullptr, cancel);
     if (half.size() != 1) return std::nullopt;
     const double n0 = h.samples[0], n1 = h.samples[1], n = n0 + n1;
     DenoiseEstimate e;
@@ -164,8 +164,8 @@ DenoiseFunction OidnDenoise(Denoiser& denoiser) {
 void DenoisedDisplay::Recheck(const Film& film, uint64_t generation) {
   const uint32_t n = film.Samples();
   if (mode_ != DenoisingMode::Auto || !last_ || generation != generation_ || settledOnFilm_ || film.Adaptive() ||
-      !film.TracksDenoiserInputs() || last_->filmEvenMean.pixels.empty() ||
-      last_->filmMean.width != film.Width() || last_->filmMean.height != film.Height())
+      !film.TracksDenoiserInputs() || last_->filmEvenMean.pixels.empty() || last_->filmMean.width != film.Width() ||
+      last_->filmMean.height != film.Height())
     return;
   const uint32_t m = last_->samples, n0 = (n + 1) / 2, m0 = (m + 1) / 2;
   if (n <= m || n0 <= m0 || n - n0 <= m - m0) return;  // new samples in both halves

@@ -42,8 +42,8 @@ const char* DenoisingModeName(DenoisingMode mode);
 struct FilmSnapshot {
   uint64_t generation = 0;  // the owner's number for the film's accumulation: a restart changes it
   uint32_t samples = 0;
-  RGBImage color;            // the film's mean
-  std::vector<float> alpha;  // its coverage
+  RGBImage color;             // the film's mean
+  std::vector<float> alpha;   // its coverage
   bool tracksInputs = false;  // the film kept its denoiser inputs
   bool hasHalves = false;     // and has 2 or more samples
   FilmHalves halves;
@@ -54,9 +54,9 @@ FilmSnapshot SnapshotFilm(const Film& film, uint64_t generation);
 // share one pair of optional guides (albedo, normal), denoised each, and a
 // flag that stops it (then it returns nothing). OidnDenoise gives Intel
 // Open Image Denoise's; the tests plant others.
-using DenoiseFunction = std::function<std::vector<RGBImage>(
-    const std::vector<const RGBImage*>& colors, const RGBImage* albedo, const RGBImage* normal,
-    const std::atomic<bool>* cancel)>;
+using DenoiseFunction =
+    std::function<std::vector<RGBImage>(const std::vector<const RGBImage*>& colors, const RGBImage* albedo,
+                                        const RGBImage* normal, const std::atomic<bool>* cancel)>;
 
 // Intel Open Image Denoise as the display's denoiser: the guides denoised
 // first, once, then each colour with them as clean guides (OIDN's advice
@@ -89,7 +89,7 @@ struct DenoisedFilm {
   RGBImage image;
   std::vector<float> alpha;
   std::optional<DenoiseEstimate> estimate;
-  double seconds = 0;  // the denoiser's time, the estimate's included
+  double seconds = 0;               // the denoiser's time, the estimate's included
   RGBImage filmMean, filmEvenMean;  // empty when the film kept no denoiser inputs
 };
 
@@ -163,12 +163,12 @@ class DenoisedDisplay {
 
  private:
   DenoisingMode mode_ = DenoisingMode::Off;
-  uint64_t generation_ = 0;            // the newest accumulation a denoise was of
-  std::optional<DenoisedFilm> last_;   // its latest denoised image
+  uint64_t generation_ = 0;                  // the newest accumulation a denoise was of
+  std::optional<DenoisedFilm> last_;         // its latest denoised image
   std::optional<DenoiseEstimate> estimate_;  // its latest estimate (of a denoise or a Recheck)
-  bool settledOnFilm_ = false;         // Auto: a denoise's estimate found the film closer
-  uint32_t rechecked_ = 0;             // the sample count of the last Recheck
-  bool busy_ = false;                  // between Started and Finished
+  bool settledOnFilm_ = false;               // Auto: a denoise's estimate found the film closer
+  uint32_t rechecked_ = 0;                   // the sample count of the last Recheck
+  bool busy_ = false;                        // between Started and Finished
   Clock::time_point finished_{};
   Clock::time_point started_{};
   double lastSeconds_ = 0, seconds_ = 0;

@@ -188,7 +188,8 @@ RGBImage Denoiser::Execute(void* filter, const std::map<const char*, const RGBIm
 RGBImage Denoiser::Denoise(const RGBImage& color, const RGBImage* albedo, const RGBImage* normal, bool cleanGuides,
                            const std::atomic<bool>* cancel) {
   if (!albedo) normal = nullptr;  // OIDN takes a normal only with an albedo
-  const int inputs = kColor | (albedo ? kAlbedo : 0) | (normal ? kNormal : 0) | (albedo && cleanGuides ? kCleanGuides : 0);
+  const int inputs =
+      kColor | (albedo ? kAlbedo : 0) | (normal ? kNormal : 0) | (albedo && cleanGuides ? kCleanGuides : 0);
   std::map<const char*, const RGBImage*> images{{"color", &color}};
   if (albedo) images["albedo"] = albedo;
   if (normal) images["normal"] = normal;

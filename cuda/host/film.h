@@ -79,9 +79,7 @@ class Film {
   // enabled: the renderers then ask the integrator for its first-hit guides
   // (IntegratorSettings::firstHitGuides). The radiance's buffers are the
   // same to the bit either way.
-  void TrackDenoiserInputs() {
-    denoiserInputs_.assign((size_t)width_ * height_ * FilmView::kDenoiserInputFloats, 0.f);
-  }
+  void TrackDenoiserInputs() { denoiserInputs_.assign((size_t)width_ * height_ * FilmView::kDenoiserInputFloats, 0.f); }
   bool TracksDenoiserInputs() const { return !denoiserInputs_.empty(); }
   // The halves and guides (std::logic_error without TrackDenoiserInputs or
   // with fewer than 2 samples in a pixel).

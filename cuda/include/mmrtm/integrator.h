@@ -121,7 +121,7 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
       out.albedo = RGB(Min(1.f, k.albedo.r + k.emission.r), Min(1.f, k.albedo.g + k.emission.g),
                        Min(1.f, k.albedo.b + k.emission.b));
       const float len = Length(firstGradient);
-      if (len > 0.f && isfinite(len)) out.normal = Dot(firstGradient, ray.d) > 0.f ? firstGradient / -len : firstGradient / len;
+      if (len > 0.f && isfinite(len)) out.normal = firstGradient / (Dot(firstGradient, ray.d) > 0.f ? -len : len);
     }
     if (depth >= s.settings.maxBounces) break;
 
