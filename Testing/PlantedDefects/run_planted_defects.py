@@ -43,6 +43,9 @@ CHECKS = [
     ("TestFurnace heterogeneous", "TestFurnace", ["--gtest_filter=Media/Furnace.ReturnsTheEnvironmentRadiance/4"],
      False),
     ("TestMajorantGrid minorants", "TestMajorantGrid", ["--gtest_filter=Accelerators/Conservative.Minorants*"], False),
+    # The VTK property's translation, rule by rule (under a second): after
+    # the tracer's checks, so that it takes no defect from them.
+    ("TestVtkTranslation", "TestVtkTranslation", [], False),
     ("TestMapperEdits", "TestMapperEdits", [], True),
     ("TestDenoisedDisplay reference scenes", "TestDenoisedDisplay",
      ["--gtest_filter=DenoisedDisplayOnReferenceScenes.*"], False),
@@ -50,7 +53,9 @@ CHECKS = [
 
 DEFECTS = ["volume_albedo", "diffuse_lobe", "specular_lobe", "phase_sign", "majorant_low", "minorant_high",
            "shadow_last_segment", "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-           "film_variance", "simd_extinction", "denoise_variance"]
+           "film_variance", "simd_extinction", "denoise_variance", "vtk_extinction", "vtk_color",
+           "vtk_gradient_opacity", "vtk_gradient_magnitude", "vtk_component_weight", "vtk_dependent_rgb",
+           "vtk_label_functions", "vtk_label_material", "vtk_ambient", "vtk_diffuse", "vtk_specular_power"]
 
 
 def configure_and_build(source, build):

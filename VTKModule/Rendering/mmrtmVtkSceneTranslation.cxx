@@ -19,6 +19,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkVolumeProperty.h>
 
+#include "mmrtm/planted_defect.h"
 #include "mmrtmVolumePropertyFunctions.h"
 #include "scene_json.h"
 
@@ -56,7 +57,8 @@ int AddCurve(Scene& scene, const std::string& where, int proxy, const std::vecto
 // transmits 1 - alpha.
 float Extinction(double alpha, double unit)
 {
-  return (float)(-std::log(1.0 - std::clamp(alpha, 0.0, 0.9999)) / unit);
+  const double sigma_t = -std::log(1.0 - std::clamp(alpha, 0.0, 0.9999)) / unit;
+  return (float)(Planted(Defect::VtkExtinction) ? 1.01 * sigma_t : sigma_t);
 }
 
 double UnitDistance(vtkVolumeProperty* property, int component)
@@ -87,8 +89,8 @@ void ApplyShading(vtkVolumeProperty* property, int component, const TranslationO
     shade ? (options.localLighting ? 1.f : kShadedSurfaceProbability) : 0.f;
   const double specular = property->GetSpecular(component),
                power = std::max(property->GetSpecularPower(component), 0.0);
-  m.base[QuantityOffset(Quantity::Roughness)] =
-    specular > 0.0 ? (float)std::clamp(std::pow(2.0 / (power + 2.0), 0.25), 0.05, 1.0) : 1.f;
+  const double roughness = std::pow(2.0 / (power + 2.0), 0.25) * (Planted(Defect::VtkSpecularPower) ? 1.01 : 1.0);
+  m.base[QuantityOffset(Quantity::Roughness)] = specular > 0.0 ? (float)std::clamp(roughness, 0.05, 1.0) : 1.f;
   if (!shade && !options.unshadedScatters)
     Glow(m);
 }
@@ -289,8 +291,9 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     f.opacity->GetTable(xo.front(), xo.back(), no, alpha.data());
   else
     alpha[0] = (float)f.opacity->GetValue(xo[0]);
+  const bool labelDefect = Planted(Defect::VtkLabelFunctions) && name.rfind("label ", 0) == 0;
   for (int i = 0; i < no; ++i)
-    density[i] = Extinction(alpha[i], UnitDistance(property, component));
+    density[i] = Extinction(alpha[i], UnitDistance(property, component)) * (labelDefect ? 1.01f : 1.f);
   m.base[QuantityOffset(Quantity::Density)] = 1.f;
   const bool iso = options.isosurface && proxies.gradient >= 0 && proxies.independent <= 1 && proxies.opacity < 0;
   if (iso)
@@ -305,7 +308,8 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
     const std::vector<float> g = Positions(proxies.gradientRange);
     std::vector<float> gv(g.size());
     for (size_t i = 0; i < g.size(); ++i)
-      gv[i] = (float)std::clamp(f.gradientOpacity->GetValue(g[i]), 0.0, 1.0);
+      gv[i] = (float)std::clamp(f.gradientOpacity->GetValue(g[i]), 0.0, 1.0) *
+        (Planted(Defect::VtkGradientOpacity) ? 0.99f : 1.f);
     m.bindings.push_back(
       { AddCurve(scene, name + " gradient opacity", proxies.gradient, g, gv, 1), Quantity::Density });
   }
@@ -323,8 +327,9 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
       std::vector<float> values = { 1.f, 1.f, 1.f, 1.f, 1.f, 1.f };
       values[c] = 0.f;
       values[3 + c] = 1.f;
+      const float scale = proxies.colorScale * (Planted(Defect::VtkDependentRgb) ? 1.01f : 1.f);
       m.bindings.push_back(
-        { AddCurve(scene, name + " rgb", proxies.rgb[c], { 0.f, proxies.colorScale }, values, 3), Quantity::Albedo });
+        { AddCurve(scene, name + " rgb", proxies.rgb[c], { 0.f, scale }, values, 3), Quantity::Albedo });
     }
   }
   else
@@ -343,7 +348,7 @@ MaterialDesc MakeMaterial(const std::string& name, const MaterialFunctions& f, v
         c[0] = c[1] = c[2] = f.grey->GetValue(x[i]);
       }
       for (int k = 0; k < 3; ++k)
-        rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0);
+        rgb[3 * i + k] = (float)std::clamp(c[k], 0.0, 1.0) * (Planted(Defect::VtkColor) ? 0.99f : 1.f);
     }
     m.bindings.push_back({ AddCurve(scene, name + " color", valueProxy, x, rgb, 3), Quantity::Albedo });
   }
@@ -485,7 +490,7 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
       // ReplaceNonFinite (the component then holds nothing).
       const double w = property->GetComponentWeight(c);
       m.base[QuantityOffset(Quantity::Density)] = std::isnan(w) ? NAN : w > 0.0 ? 1.f : 0.f;
-      ScaleColour(m, std::isnan(w) ? 0.f : (float)(w * w));
+      ScaleColour(m, std::isnan(w) ? 0.f : (float)(w * w) * (Planted(Defect::VtkComponentWeight) ? 0.99f : 1.f));
       scene.materials.push_back(std::move(m));
     }
     scene.additiveMaterials = true;
@@ -604,7 +609,8 @@ void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property,
   const nlohmann::json rule = LabelMaterial(look);
   MaterialDesc m;
   m.name = "label " + std::to_string(label);
-  m.base[QuantityOffset(Quantity::Density)] = rule["density"].get<float>();
+  m.base[QuantityOffset(Quantity::Density)] =
+    rule["density"].get<float>() * (Planted(Defect::VtkLabelMaterial) ? 0.99f : 1.f);
   for (int c = 0; c < 3; ++c)
     m.base[QuantityOffset(Quantity::Albedo) + c] = rule["albedo"][c].get<float>();
   ApplyShading(property, component, options, m);
@@ -735,7 +741,7 @@ void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene&
     if (!(distance > 0.f))
       continue;
     const double* col = light->GetDiffuseColor();
-    const float scale = kPi * (float)(light->GetIntensity() * diffuse);
+    const float scale = kPi * (float)(light->GetIntensity() * diffuse) * (Planted(Defect::VtkDiffuse) ? 0.99f : 1.f);
     Light l;
     l.L = RGB((float)col[0] * scale, (float)col[1] * scale, (float)col[2] * scale);
     if (light->GetPositional())
@@ -756,7 +762,7 @@ void SetLightsFromVtk(vtkRenderer* renderer, vtkVolumeProperty* property, Scene&
     }
     scene.lights.push_back(l);
   }
-  const float ambient = (float)property->GetAmbient(0);
+  const float ambient = (float)property->GetAmbient(0) * (Planted(Defect::VtkAmbient) ? 0.99f : 1.f);
   scene.environment = ambient > 0.f ? EnvironmentMap::Constant(RGB(ambient, ambient, ambient)) : nullptr;
 }
 

@@ -37,15 +37,49 @@ enum class Defect : uint8_t {
   FilmVariance,       // the film's variance of the mean halved
   SimdExtinction,     // the SIMD lanes' extinction x0.98 (the scalar lookups untouched)
   DenoiseVariance,    // Auto's estimate subtracts Var A + Var B (the halves' whole difference), not Var B
+  // The VTK property's translation (VTKModule/Rendering/mmrtmVtkSceneTranslation.cxx), each rule 1 % off:
+  VtkExtinction,         // sigma_t from scalar opacity per unit distance x1.01
+  VtkColor,              // the colour (or grey) table x0.99
+  VtkGradientOpacity,    // the gradient-opacity table x0.99
+  VtkGradientMagnitude,  // the gradient-magnitude proxy x1.01 (cuda/host/derived_proxies.cpp)
+  VtkComponentWeight,    // an independent component's colour x0.99 w^2
+  VtkDependentRgb,       // dependent RGBA: the colour components divided by 1.01 x 255
+  VtkLabelFunctions,     // a label's own scalar-opacity table x1.01 (sigma_t)
+  VtkLabelMaterial,      // SetLabelMaterial's extinction x0.99
+  VtkAmbient,            // the ambient environment's radiance x0.99
+  VtkDiffuse,            // the lights' radiance (times Diffuse) x0.99
+  VtkSpecularPower,      // the roughness from SpecularPower x1.01
   Count
 };
 
 // The names MMRTM_PLANTED_DEFECT takes, in Defect's order.
 inline const char* DefectName(Defect d) {
-  static const char* const names[] = {"none",          "volume_albedo",   "diffuse_lobe",       "specular_lobe",
-                                      "phase_sign",    "majorant_low",    "minorant_high",      "shadow_last_segment",
-                                      "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-                                      "film_variance", "simd_extinction", "denoise_variance"};
+  static const char* const names[] = {"none",
+                                      "volume_albedo",
+                                      "diffuse_lobe",
+                                      "specular_lobe",
+                                      "phase_sign",
+                                      "majorant_low",
+                                      "minorant_high",
+                                      "shadow_last_segment",
+                                      "light_weights",
+                                      "environment_pdf",
+                                      "mapper_color_refit",
+                                      "label_swap",
+                                      "film_variance",
+                                      "simd_extinction",
+                                      "denoise_variance",
+                                      "vtk_extinction",
+                                      "vtk_color",
+                                      "vtk_gradient_opacity",
+                                      "vtk_gradient_magnitude",
+                                      "vtk_component_weight",
+                                      "vtk_dependent_rgb",
+                                      "vtk_label_functions",
+                                      "vtk_label_material",
+                                      "vtk_ambient",
+                                      "vtk_diffuse",
+                                      "vtk_specular_power"};
   static_assert(sizeof(names) / sizeof(names[0]) == (size_t)Defect::Count, "a name per defect");
   return names[(int)d];
 }
