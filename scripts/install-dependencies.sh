@@ -18,6 +18,7 @@ packages=(
   invesalius-examples   # the default input: Cranium.inv3
   debootstrap           # the ParaView root of the plugin's build and tests (scripts/paraview-root.sh)
   chromium chromium-driver   # mmrtm-web's test: a real browser, headless, driven by selenium
+  openssl                    # mmrtm-web's TLS test: a certificate made at test time
 )
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi

@@ -18,7 +18,6 @@ chromium and chromium-driver, and MMRTM_SHARED_DATA_DIR (default
 import argparse
 import os
 import shutil
-import socket
 import statistics
 import subprocess
 import sys
@@ -34,7 +33,7 @@ from selenium.webdriver.chrome.options import Options  # noqa: E402
 from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 
-from test_web import CHROMIUM, DRIVER, FRAME_STATISTICS, RECORDER, free_port  # noqa: E402
+from test_web import CHROMIUM, DRIVER, FRAME_STATISTICS, RECORDER, free_port, printed_address  # noqa: E402
 
 
 def cpu_seconds(pid):
@@ -57,17 +56,11 @@ class Session:
     def __init__(self, study, streaming, maximum_samples):
         self.port = free_port()
         script = shutil.which("mmrtm-web", path=os.path.dirname(sys.executable))
-        self.log = tempfile.TemporaryFile()
+        self.log = tempfile.NamedTemporaryFile()
         self.server = subprocess.Popen([script, study, "--port", str(self.port), "--streaming", streaming,
                                         "--maximum-samples", str(maximum_samples)],
                                        stdout=self.log, stderr=subprocess.STDOUT)
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline:
-            try:
-                with socket.create_connection(("127.0.0.1", self.port), timeout=1):
-                    break
-            except OSError:
-                time.sleep(0.25)
+        self.address = printed_address(self.server, self.log.name)
         # What it does before any browser connects.
         time.sleep(1)
         cpu = cpu_seconds(self.server.pid)
@@ -119,7 +112,7 @@ def measure(study, streaming, maximum_samples):
     try:
         browser = session.browser
         asked, asked_epoch = time.monotonic(), time.time()
-        browser.get("http://127.0.0.1:%d/" % session.port)
+        browser.get(session.address)
         browser.execute_script(RECORDER)
         first = session.wait(lambda: session.statistics() and session.statistics()[0] > 100, 60)
         # Polled slowly: the browser's work would take the server's cores.

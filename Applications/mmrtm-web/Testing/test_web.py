@@ -170,6 +170,21 @@ def free_port():
         return s.getsockname()[1]
 
 
+def printed_address(server, log_path, timeout=120):
+    """The address `server` (a mmrtm-web process writing to `log_path`)
+    prints once it listens, with its access key, as a user would copy it."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if server.poll() is not None:
+            raise RuntimeError("mmrtm-web exited with %d: see %s" % (server.returncode, log_path))
+        with open(log_path) as f:
+            found = re.search(r"^mmrtm-web: open (\S+)$", f.read(), re.MULTILINE)
+        if found:
+            return found.group(1)
+        time.sleep(0.25)
+    raise RuntimeError("mmrtm-web printed no address within %.0f s: see %s" % (timeout, log_path))
+
+
 class WebViewerTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -230,17 +245,11 @@ class WebViewerTest(unittest.TestCase):
         cls.downloads.cleanup()
 
     def open_page(self):
-        """Loads the page once the server answers (it loads the volume first)."""
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline:
-            self.assertIsNone(self.server.poll(), "the server exited: see mmrtm-web-test.log")
-            try:
-                with socket.create_connection(("127.0.0.1", self.port), timeout=1):
-                    break
-            except OSError:
-                time.sleep(0.25)
+        """Loads the page at the address the server printed once it listens
+        (it loads the volume first)."""
+        address = printed_address(self.server, self.log.name)
         start = time.monotonic()
-        self.browser.get("http://127.0.0.1:%d/" % self.port)
+        self.browser.get(address)
         self.browser.execute_script(RECORDER)
         return start
 

@@ -1,6 +1,7 @@
 """mmrtm-web: a study path traced by MM-RTM in a browser, on trame-slicer.
 
     mmrtm-web [VOLUME_OR_DICOM_FOLDER] [--data-root DIR] [--host 127.0.0.1] [--port 8080]
+              [--token-file FILE] [--certfile CERT --keyfile KEY]
 
 Serves a page with Slicer's layouts (the 3D view path traced by our method,
 the axial, coronal and sagittal slices beside it), Slicer's Volume
@@ -9,13 +10,20 @@ studies of the data root to open or a file to upload. The 3D view refines
 in the background (the display node's AsynchronousRefinement) and is
 streamed one frame per sample pass (streaming.py). Documentation/web.md
 says what it does and does not do yet.
+
+Only the holder of the server's access key gets anything from it: the
+address printed at start carries the key (access.py); TLS by
+--certfile/--keyfile, required beyond this machine unless --insecure.
 """
 import argparse
 import ipaddress
 import os
+import socket
 import sys
 
 from . import transfer_functions
+from .access import SHORTEST_TOKEN, TOKEN_ENVIRONMENT, AccessError, AccessKey, chosen_token, tls_context
+from .clients import ClientPresence
 from .studies import DEFAULT_STUDY, StudyLoader
 from .transfer_functions import hex_colour
 
@@ -47,7 +55,8 @@ def parse_arguments(argv):
                         "(default: the head CT of Debian's invesalius-examples)")
     parser.add_argument("--data-root", help="the folder the page may open studies from (default: the study's "
                         "folder); paths that lead outside it are refused")
-    parser.add_argument("--host", default="127.0.0.1", help="address to serve on (default: loopback only)")
+    parser.add_argument("--host", default="127.0.0.1", help="address to serve on (default: loopback only; "
+                        "any other needs --certfile or --insecure)")
     parser.add_argument("--port", type=int, default=8080, help="port (default 8080; 0: any free port)")
     parser.add_argument("--preset", default=DEFAULT_PRESET, help="Volume Rendering preset (default CT-Bone)")
     parser.add_argument("--maximum-samples", type=int, default=64, help="samples per pixel to refine to (default 64)")
@@ -56,7 +65,49 @@ def parse_arguments(argv):
     parser.add_argument("--streaming", choices=("progressive", "trame-rca"), default="progressive",
                         help="how the 3D view is streamed: one frame per sample pass (default), or trame-rca's "
                         "own scheduler, to compare (Testing/Benchmarks/bench_web.py)")
+    access = parser.add_argument_group("access", "who may use the server (Documentation/web.md, Security)")
+    access.add_argument("--token-file", help="the access key in the file's first line (at least %d characters; "
+                        "default: %s, else a random key made at start and printed in the address to open)"
+                        % (SHORTEST_TOKEN, TOKEN_ENVIRONMENT))
+    access.add_argument("--no-token", action="store_true",
+                        help="serve without an access key: anyone who can reach the port sees the studies "
+                        "(loopback only)")
+    access.add_argument("--certfile", help="serve over HTTPS with this PEM certificate (and its key, unless "
+                        "--keyfile names another file)")
+    access.add_argument("--keyfile", help="the certificate's private key (PEM)")
+    access.add_argument("--insecure", action="store_true",
+                        help="allow a --host beyond this machine without TLS (the key and the images cross the "
+                        "network in the clear)")
     return parser.parse_args(argv)
+
+
+def access_settings(args, environment=os.environ):
+    """The key (None without one) and the TLS context (None without TLS) the
+    arguments ask for, or a message for the user when they are unsafe or
+    unusable."""
+    if args.keyfile and not args.certfile:
+        raise AccessError("--keyfile needs --certfile")
+    context = tls_context(args.certfile, args.keyfile) if args.certfile else None
+    if args.no_token:
+        if args.token_file:
+            raise AccessError("--no-token and --token-file contradict each other")
+        if not is_loopback(args.host):
+            raise AccessError("--no-token serves only on loopback (--host %s would let anyone who reaches the "
+                              "port see the studies)" % args.host)
+        return None, context
+    if not is_loopback(args.host) and context is None and not args.insecure:
+        raise AccessError("--host %s serves beyond this machine: give --certfile and --keyfile for TLS, or "
+                          "--insecure to send the key and the images in the clear" % args.host)
+    return chosen_token(args.token_file, environment), context
+
+
+def address_to_open(host, port, token, tls):
+    """The URL the user opens: this server with its key."""
+    if host in ("0.0.0.0", "::", ""):
+        host = socket.getfqdn()
+    if ":" in host:
+        host = "[%s]" % host
+    return "%s://%s:%d/%s" % ("https" if tls else "http", host, port, "?token=" + token if token else "")
 
 
 def is_loopback(host):
@@ -75,7 +126,7 @@ class WebViewer:
         from trame_slicer.core import LayoutManager, SlicerApp
         from slicer import vtkSlicerMultiMaterialVolumeRenderingLogic
 
-        from .streaming import ClientPresence, register_view_factories
+        from .streaming import register_view_factories
 
         self.server = get_server(server, client_type="vue3")
         self.slicer = SlicerApp()
@@ -426,16 +477,42 @@ def main(argv=None):
         root = DataRoot(args.data_root or os.path.dirname(os.path.abspath(args.volume.rstrip("/"))))
     except ValueError as e:
         sys.exit("mmrtm-web: error: %s" % e)
-    if not is_loopback(args.host):
-        print("mmrtm-web: warning: serving on %s, beyond this machine, with no authentication: put it behind a "
-              "reverse proxy that authenticates (Documentation/web.md)" % args.host, file=sys.stderr)
+    try:
+        token, context = access_settings(args)
+    except AccessError as e:
+        sys.exit("mmrtm-web: error: %s" % e)
+    if not is_loopback(args.host) and context is None:
+        print("mmrtm-web: warning: serving on %s without TLS (--insecure): the key and the images cross the "
+              "network in the clear" % args.host, file=sys.stderr, flush=True)
+    if token is None:
+        print("mmrtm-web: warning: no access key (--no-token): every user and process of this machine can open "
+              "the studies", file=sys.stderr, flush=True)
     try:
         viewer = WebViewer(os.path.abspath(args.volume), root, preset=args.preset,
                            maximum_samples=args.maximum_samples, upload_limit_mb=args.upload_limit_mb,
                            streaming=args.streaming)
     except ValueError as e:
         sys.exit("mmrtm-web: error: %s" % e)
-    viewer.server.start(host=args.host, port=args.port, open_browser=False)
+    serve(viewer, args.host, args.port, token, context)
+
+
+def serve(viewer, host, port, token, context):
+    """Starts the viewer's server behind the key (when there is one) and TLS
+    (when `context`), and prints the address to open once it listens."""
+    server = viewer.server
+
+    def bind(web_server):
+        # The key's check first: a refused request is not a browser.
+        if token is not None:
+            web_server.app.middlewares.append(AccessKey(token, secure_cookie=context is not None).middleware())
+        web_server.app.middlewares.append(viewer.presence.middleware())
+        if context is not None:
+            web_server.config["ssl"] = context
+
+    server.controller.on_server_bind.add(bind)
+    server.controller.on_server_ready.add(lambda **_: print(
+        "mmrtm-web: open %s" % address_to_open(host, server.port, token, context is not None), flush=True))
+    server.start(host=host, port=port, open_browser=False, show_connection_info=False)
 
 
 if __name__ == "__main__":

@@ -31,9 +31,9 @@ import asyncio
 from trame_rca.schedulers import RcaImageRenderScheduler
 
 
-def path_traced_mappers(render_window):
-    """Our mappers among the window's visible volumes."""
-    mappers = []
+def path_traced_volumes(render_window):
+    """The window's visible volumes that our mapper draws."""
+    found = []
     renderers = render_window.GetRenderers()
     renderers.InitTraversal()
     for _ in range(renderers.GetNumberOfItems()):
@@ -43,29 +43,13 @@ def path_traced_mappers(render_window):
             volume = volumes.GetNextVolume()
             mapper = volume.GetMapper()
             if volume.GetVisibility() and mapper is not None and mapper.IsA("vtkMultiMaterialVolumeMapper"):
-                mappers.append(mapper)
-    return mappers
+                found.append(volume)
+    return found
 
 
-class ClientPresence:
-    """How many browsers have the page open (trame's client life cycle)."""
-
-    def __init__(self, server):
-        self.count = 0
-        self.listeners = []
-        server.controller.on_client_connected.add(self.connected)
-        server.controller.on_client_exited.add(self.exited)
-
-    def connected(self):
-        self.count += 1
-        for listener in self.listeners:
-            listener()
-
-    def exited(self):
-        self.count = max(0, self.count - 1)
-
-    def __bool__(self):
-        return self.count > 0
+def path_traced_mappers(render_window):
+    """Our mappers among the window's visible volumes."""
+    return [volume.GetMapper() for volume in path_traced_volumes(render_window)]
 
 
 class ProgressiveRenderScheduler(RcaImageRenderScheduler):
@@ -93,11 +77,13 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         self.frames = 0
         self.stalled_at = None
         self.pushed = None  # progress() when the last frame was rendered
+        self.shown_scene = None  # scene() when the last frame was rendered
         # The VTK window behind trame-rca's area: its `render_window`
         # property renders, which this must not do to look at the mappers.
         self.render_window = window._vtk_render_window
         super().__init__(window, **kwargs)
-        presence.listeners.append(self.schedule_render)
+        presence.arrival_listeners.append(self.schedule_render)
+        presence.departure_listeners.append(self.end_abandoned_interaction)
 
     def mappers(self):
         return path_traced_mappers(self.render_window)
@@ -137,6 +123,27 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         return ([(m.GetAccumulatedSamples(), m.GetNumberOfDenoises()) for m in mappers],
                 self.render_window.GetDesiredUpdateRate())
 
+    def scene(self):
+        """What restarts the refinement when it changes: the view's size,
+        each camera, and each of our volumes with its property, mapper and
+        input (their modification times). A request with the scene as it
+        was (a browser that connects and sends the view's size as it is)
+        is answered with the frame as it is, without a preview: a preview
+        would stop the pass in flight and start the accumulation again.
+        Something missed here only costs a change its preview."""
+        cameras = []
+        renderers = self.render_window.GetRenderers()
+        renderers.InitTraversal()
+        for _ in range(renderers.GetNumberOfItems()):
+            camera = renderers.GetNextItem().GetActiveCamera()
+            cameras.append((camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle(),
+                            camera.GetParallelProjection(), camera.GetParallelScale()))
+        volumes = []
+        for volume in path_traced_volumes(self.render_window):
+            data = volume.GetMapper().GetInput()
+            volumes.append((volume.GetMTime(), volume.GetMapper().GetMTime(), data.GetMTime() if data else 0))
+        return self.render_window.GetSize(), cameras, volumes
+
     def push_frame(self):
         self._render_frame(self._interactive_quality)
         self.frames += 1
@@ -144,14 +151,25 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
     def interacting(self):
         return self.render_window.GetDesiredUpdateRate() > self.render_window.GetInteractor().GetStillUpdateRate()
 
+    def end_abandoned_interaction(self):
+        """A browser left: a drag still in progress may be its own, whose
+        button's release will never come (the interaction would hold the
+        view in its preview for every other browser); the buttons are
+        released where the pointer last was, which moves nothing."""
+        if not self.interacting():
+            return
+        interactor = self.render_window.GetInteractor()
+        interactor.LeftButtonReleaseEvent()
+        interactor.MiddleButtonReleaseEvent()
+        interactor.RightButtonReleaseEvent()
+        self.schedule_render()
+
     async def push_preview(self):
         """A change outside an interaction (a preset, an edit, a resize)
         shown first as an interaction's preview, which takes tens of
         milliseconds, before the first full pass, which takes a second or
         more on a CPU and holds the server meanwhile: the preview is sent
-        on its way before that pass starts. (A request that changed
-        nothing would stop the pass in flight for nothing; none is seen:
-        hovering over the views asks for no render.)"""
+        on its way before that pass starts."""
         still = self.render_window.GetDesiredUpdateRate()
         self.render_window.SetDesiredUpdateRate(self.render_window.GetInteractor().GetDesiredUpdateRate())
         pushed = self._last_push_time_ms
@@ -179,7 +197,7 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
             self._request_event.clear()
             mappers = self.mappers()
             before = self.progress(mappers)
-            changed = requested and mappers and not self.interacting()
+            changed = requested and mappers and not self.interacting() and self.scene() != self.shown_scene
             if changed:
                 await self.push_preview()
             elif not requested and before == self.pushed:
@@ -199,6 +217,7 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
             mappers = self.mappers()
             after = self.progress(mappers)
             self.pushed = after
+            self.shown_scene = self.scene()
             # Nothing more comes of rendering again without a request or a
             # change of mode: after an interaction's preview (no samples
             # accumulate), or after a render that was not asked for and
