@@ -951,8 +951,50 @@ class MapperTest(unittest.TestCase):
         self.assertTrue(asynchronous.mapper.IsRefining())
         asynchronous.renderer.GetActiveCamera().Azimuth(30)
         asynchronous.render()
-        self.assertEqual(asynchronous.counts()[2], 3)  # the settings change, then the camera
+        self.assertEqual(asynchronous.counts()[2], 2)  # the camera's (the maximum's change keeps the samples)
         self.assertEqual(asynchronous.mapper.GetAccumulatedSamples(), 2)
+
+    def test_settings_that_leave_the_converged_image_keep_the_samples(self):
+        """The samples per render, the maximum samples, the noise target, the
+        threads and asynchronous refinement do not change the converged
+        image: a change of any of them keeps the samples accumulated, and
+        the film goes on as if nothing had changed (the same bits as a film
+        refined to the end without the changes). Catches a setter that
+        restarts (a converged view thrown away when a front end raises its
+        maximum), and one that keeps samples a change should discard (the
+        seed's change restarts)."""
+        s = Scene()
+        for _ in range(4):
+            s.render()
+        self.assertTrue(s.mapper.IsConverged())
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 8)
+        counts = s.counts()
+        s.mapper.SetMaximumSamples(16)
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 10, "raised: refinement goes on from 8")
+        s.mapper.SetSamplesPerRender(4)
+        s.mapper.SetNumberOfThreads(1)
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 14)
+        s.mapper.SetNoiseTarget(0.001)
+        s.mapper.AsynchronousRefinementOn()
+        s.mapper.AsynchronousRefinementOff()
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 16)
+        self.assertEqual(s.counts(), counts, "no restart, rebuild or refit")
+        reference = Scene()
+        reference.mapper.SetMaximumSamples(16)
+        for _ in range(8):
+            reference.render()
+        self.assertEqual(reference.mapper.GetAccumulatedSamples(), 16)
+        self.assertEqual(film(s.mapper), film(reference.mapper), "the same film as one refined without changes")
+        s.mapper.SetMaximumSamples(4)
+        s.render()
+        self.assertEqual(s.mapper.GetAccumulatedSamples(), 16, "lowered below them: the image keeps them all")
+        self.assertTrue(s.mapper.IsConverged())
+        s.mapper.SetSeed(4)
+        s.render()
+        self.assertEqual(s.counts()[2], counts[2] + 1, "another seed is another image: a restart")
 
     def test_same_seed_same_image(self):
         a, b = Scene(), Scene()

@@ -247,9 +247,10 @@ struct vtkMultiMaterialVolumeMapper::Internals
   bool ShowedDenoised = false;
   std::string DisplayStatus; // GetDisplayStatus's
 
-  // The last display edit (exposure, tone mapping): the mapper's
-  // modification time before it (as TracingMTime gave it) and after.
-  vtkMTimeType DisplayEditBefore = 0, DisplayEditAfter = 0;
+  // The last edit that keeps the samples (EditKeepingSamples): the
+  // mapper's modification time before it (as TracingMTime gave it) and
+  // after.
+  vtkMTimeType KeptEditBefore = 0, KeptEditAfter = 0;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0, GridRefits = 0;
   // After a Scene.Build: what it did to the majorant grid.
@@ -543,14 +544,14 @@ void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
 {
   exposure = std::max(0.0, exposure);
   if (exposure != this->Exposure)
-    this->DisplayEdit([&] { this->Exposure = exposure; });
+    this->EditKeepingSamples([&] { this->Exposure = exposure; });
 }
 
 void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
 {
   mode = std::clamp(mode, static_cast<int>(AUTOMATIC_TONE_MAPPING), static_cast<int>(FILMIC_TONE_MAPPING));
   if (mode != this->ToneMapping)
-    this->DisplayEdit([&] { this->ToneMapping = mode; });
+    this->EditKeepingSamples([&] { this->ToneMapping = mode; });
 }
 
 void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
@@ -558,7 +559,7 @@ void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
   mode = std::clamp(mode, static_cast<int>(DENOISING_OFF), static_cast<int>(DENOISING_ALWAYS));
   if (mode == this->DenoisingMode)
     return;
-  this->DisplayEdit([&] { this->DenoisingMode = mode; });
+  this->EditKeepingSamples([&] { this->DenoisingMode = mode; });
   this->Internal->Display.SetMode(mode == DENOISING_AUTO ? mmrtm::DenoisingMode::Auto
       : mode == DENOISING_ALWAYS                         ? mmrtm::DenoisingMode::Always
                                                          : mmrtm::DenoisingMode::Off);
@@ -568,7 +569,41 @@ void vtkMultiMaterialVolumeMapper::SetCpuSimd(int mode)
 {
   mode = std::clamp(mode, static_cast<int>(CPU_SIMD_AUTO), static_cast<int>(CPU_SIMD_OFF));
   if (mode != this->CpuSimd)
-    this->DisplayEdit([&] { this->CpuSimd = mode; });
+    this->EditKeepingSamples([&] { this->CpuSimd = mode; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetSamplesPerRender(int samples)
+{
+  samples = std::clamp(samples, 1, 65536);
+  if (samples != this->SamplesPerRender)
+    this->EditKeepingSamples([&] { this->SamplesPerRender = samples; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetMaximumSamples(int samples)
+{
+  samples = std::max(samples, 0);
+  if (samples != this->MaximumSamples)
+    this->EditKeepingSamples([&] { this->MaximumSamples = samples; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetNoiseTarget(double target)
+{
+  target = std::clamp(target, 0.0, 1.0);
+  if (target != this->NoiseTarget)
+    this->EditKeepingSamples([&] { this->NoiseTarget = target; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetNumberOfThreads(int threads)
+{
+  threads = std::clamp(threads, 0, 1024);
+  if (threads != this->NumberOfThreads)
+    this->EditKeepingSamples([&] { this->NumberOfThreads = threads; });
+}
+
+void vtkMultiMaterialVolumeMapper::SetAsynchronousRefinement(vtkTypeBool asynchronous)
+{
+  if (asynchronous != this->AsynchronousRefinement)
+    this->EditKeepingSamples([&] { this->AsynchronousRefinement = asynchronous; });
 }
 
 void vtkMultiMaterialVolumeMapper::SetLookToVTK()
@@ -584,25 +619,27 @@ void vtkMultiMaterialVolumeMapper::SetLookToFilmic()
 }
 
 template <class Edit>
-void vtkMultiMaterialVolumeMapper::DisplayEdit(Edit edit)
+void vtkMultiMaterialVolumeMapper::EditKeepingSamples(Edit edit)
 {
   Internals& in = *this->Internal;
   const vtkMTimeType before = this->TracingMTime();
   edit();
   this->Modified();
-  in.DisplayEditBefore = before;
-  in.DisplayEditAfter = this->GetMTime();
+  in.KeptEditBefore = before;
+  in.KeptEditAfter = this->GetMTime();
 }
 
 vtkMTimeType vtkMultiMaterialVolumeMapper::TracingMTime()
 {
-  // The mapper's modification time as far as tracing goes: a display edit
-  // (exposure, tone mapping: only DrawFilm reads them; the CPU's SIMD
-  // switch: the same film either way) with nothing
-  // modified after it leaves the time it had before, so the accumulation
-  // goes on.
+  // The mapper's modification time as far as tracing goes: an edit that
+  // keeps the samples (exposure, tone mapping and the denoised display:
+  // only the drawing reads them; the samples per render, the maximum
+  // samples and the noise target: how far refinement goes; the threads,
+  // the SIMD switch and the asynchronous refinement: the same film either
+  // way) with nothing modified after it leaves the time it had before, so
+  // the accumulation goes on.
   const vtkMTimeType t = this->GetMTime();
-  return t == this->Internal->DisplayEditAfter ? this->Internal->DisplayEditBefore : t;
+  return t == this->Internal->KeptEditAfter ? this->Internal->KeptEditBefore : t;
 }
 
 void vtkMultiMaterialVolumeMapper::SetMaskInput(vtkImageData* mask)

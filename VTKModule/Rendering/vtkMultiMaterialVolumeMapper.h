@@ -19,7 +19,11 @@
  *   (GetNumberOfRefits());
  * - a change of the camera, a light, the viewport or the volume's matrix:
  *   the accumulation restarts (GetNumberOfRestarts());
- * - the exposure: the accumulated samples are drawn again, not restarted;
+ * - the exposure, the tone mapping, the denoised display: the accumulated
+ *   samples are drawn again, not restarted;
+ * - the samples per render, the maximum samples, the noise target, the
+ *   threads, the CPU's SIMD, asynchronous refinement: the accumulation goes
+ *   on from the samples it has (none of them changes the converged image);
  * - nothing changed: samples are added.
  *
  * The volume's matrix (vtkProp3D) is honoured, so oblique orientations and
@@ -75,18 +79,21 @@ public:
 
   ///@{
   /**
-   * Samples per pixel added by each Render() (default 4).
+   * Samples per pixel added by each Render() (default 4). A change keeps
+   * the samples accumulated.
    */
-  vtkSetClampMacro(SamplesPerRender, int, 1, 65536);
+  void SetSamplesPerRender(int samples);
   vtkGetMacro(SamplesPerRender, int);
   ///@}
 
   ///@{
   /**
    * Samples per pixel after which Render() only redraws the image
-   * (default 256; 0 accumulates without limit).
+   * (default 256; 0 accumulates without limit). A change keeps the samples
+   * accumulated: raised, refinement goes on from them; lowered below them,
+   * the image keeps them all.
    */
-  vtkSetClampMacro(MaximumSamples, int, 0, VTK_INT_MAX);
+  void SetMaximumSamples(int samples);
   vtkGetMacro(MaximumSamples, int);
   ///@}
 
@@ -96,9 +103,10 @@ public:
    * square standard error of the pixels' luminance over their mean
    * luminance, measured by the difference between each pixel's even and
    * odd samples) at which Render() stops adding samples, as it does at
-   * MaximumSamples; 0 (the default) has no noise target.
+   * MaximumSamples; 0 (the default) has no noise target. A change keeps
+   * the samples accumulated.
    */
-  vtkSetClampMacro(NoiseTarget, double, 0.0, 1.0);
+  void SetNoiseTarget(double target);
   vtkGetMacro(NoiseTarget, double);
   ///@}
 
@@ -113,9 +121,10 @@ public:
 
   ///@{
   /**
-   * CPU threads, 0 for all (default 0).
+   * CPU threads, 0 for all (default 0). A change keeps the samples
+   * accumulated (the image does not depend on the thread count).
    */
-  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  void SetNumberOfThreads(int threads);
   vtkGetMacro(NumberOfThreads, int);
   ///@}
 
@@ -221,7 +230,7 @@ public:
    * count). IsRefining() says whether a pass (or a denoise) is in flight:
    * an application renders again a little later to pick up its samples.
    */
-  vtkSetMacro(AsynchronousRefinement, vtkTypeBool);
+  void SetAsynchronousRefinement(vtkTypeBool asynchronous);
   vtkGetMacro(AsynchronousRefinement, vtkTypeBool);
   vtkBooleanMacro(AsynchronousRefinement, vtkTypeBool);
   bool IsRefining();
@@ -692,10 +701,11 @@ private:
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
   vtkMTimeType TracingMTime();
-  // Applies `edit` to a setting only DrawFilm reads (exposure, tone
-  // mapping): the accumulation goes on (TracingMTime).
+  // Applies `edit` to a setting that leaves the converged image as it is
+  // (what DrawFilm reads, how far and how refinement goes, the CPU's
+  // threads and SIMD): the accumulation goes on (TracingMTime).
   template <class Edit>
-  void DisplayEdit(Edit edit);
+  void EditKeepingSamples(Edit edit);
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;

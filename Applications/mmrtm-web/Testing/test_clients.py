@@ -10,7 +10,8 @@ from the first; a disconnect mid-pass, mid-drag or by reload that stops
 the refinement the first browser watches (its sample count stops rising),
 crashes the server or leaves it rendering previews; a page opened twice in
 one browser that breaks either; memory that grows with each connect and
-leave (50 cycles, the growth bound below).
+leave (50 cycles, the growth bound below); the page's maximum samples,
+raised, throwing the converged view's samples away.
 """
 import os
 import re
@@ -24,6 +25,7 @@ from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.keys import Keys
 
 from test_web import CHROMIUM, DRIVER, FRAME_STATISTICS, free_port, printed_address
 
@@ -196,13 +198,14 @@ class ClientsTest(SharedServerTest):
 
 class CyclesTest(SharedServerTest):
     """Fifty browsers come and go while the first one watches a view at
-    rest (converged: the memory measured is the connections' own)."""
+    rest (converged: the memory measured is the connections' own); then
+    the page's maximum samples is raised."""
     maximum_samples = 16
 
     def status(self):
         return self.first.find_element("css selector", ".refinement-status").text.split("\n")[0]
 
-    def test_connecting_and_leaving_fifty_times(self):
+    def test_a_connecting_and_leaving_fifty_times(self):
         self.frame(self.first)
         deadline = time.monotonic() + 120
         while "(converged)" not in self.status() and time.monotonic() < deadline:
@@ -228,6 +231,26 @@ class CyclesTest(SharedServerTest):
               "'%s' -> '%s'" % (CYCLES, resident_before, resident_after, converged, self.status()))
         self.assertLess(resident_after - resident_before, CYCLE_GROWTH_BOUND_MIB)
         self.assertEqual(self.status(), converged, "the converged view kept, not started again")
+
+    def test_b_a_higher_maximum_goes_on_from_the_samples_shown(self):
+        """The page's maximum samples raised on a converged view: the
+        refinement goes on from its samples (a restart would show fewer)."""
+        self.frame(self.first)
+        deadline = time.monotonic() + 120
+        while "(converged)" not in self.status() and time.monotonic() < deadline:
+            time.sleep(0.5)
+        converged = self.samples(self.first)
+        field = self.first.find_element("css selector", ".maximum-samples input")
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys(str(converged + 8))
+        fewest, deadline = converged, time.monotonic() + 60
+        while time.monotonic() < deadline and not self.status().startswith("%d / %d" % ((converged + 8,) * 2)):
+            fewest = min(fewest, self.samples(self.first))
+            time.sleep(0.1)
+        print("maximum %d -> %d: the samples shown went %d -> %s (fewest %d)"
+              % (converged, converged + 8, converged, self.status(), fewest))
+        self.assertTrue(self.status().startswith("%d / %d" % ((converged + 8,) * 2)), self.status())
+        self.assertEqual(fewest, converged, "never started again")
 
 
 if __name__ == "__main__":

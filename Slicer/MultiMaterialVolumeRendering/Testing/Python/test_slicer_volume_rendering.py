@@ -250,6 +250,22 @@ class ViewTest(unittest.TestCase):
         self.assertEqual(mapper.GetAccumulatedSamples(), 8)
         self.assertEqual(film(mapper), synchronous, "the same film in the background")
 
+    def test_a_higher_maximum_keeps_the_samples(self):
+        """The display node's maximum samples raised on a converged view:
+        refinement goes on from the samples it has. Catches a display node
+        or displayable manager whose setting restarts the view (the
+        converged image thrown away)."""
+        mapper = self.view.mapper()
+        self.assertTrue(mapper.IsConverged())
+        converged, counts = mapper.GetAccumulatedSamples(), self.counts()
+        self.display.SetMaximumSamples(2 * converged)
+        self.display.SetNoiseTarget(0.0001)
+        self.view.render()
+        self.assertGreater(mapper.GetAccumulatedSamples(), converged)
+        self.assertEqual(self.counts(), counts, "no restart")
+        self.view.refine()
+        self.assertEqual(mapper.GetAccumulatedSamples(), 2 * converged)
+
     def test_refinement_stops_at_the_noise_target(self):
         self.display.SetMaximumSamples(0)
         self.display.SetNoiseTarget(0.9 * self.view.mapper().GetRelativeNoise())
