@@ -248,7 +248,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::string DisplayStatus; // GetDisplayStatus's
 
   // The last edit that keeps the samples (EditKeepingSamples): the
-  // mapper's modification time before it (as TracingMTime gave it) and
+  // mapper's modification time before it (as GetTracingMTime gave it) and
   // after.
   vtkMTimeType KeptEditBefore = 0, KeptEditAfter = 0;
 
@@ -622,14 +622,14 @@ template <class Edit>
 void vtkMultiMaterialVolumeMapper::EditKeepingSamples(Edit edit)
 {
   Internals& in = *this->Internal;
-  const vtkMTimeType before = this->TracingMTime();
+  const vtkMTimeType before = this->GetTracingMTime();
   edit();
   this->Modified();
   in.KeptEditBefore = before;
   in.KeptEditAfter = this->GetMTime();
 }
 
-vtkMTimeType vtkMultiMaterialVolumeMapper::TracingMTime()
+vtkMTimeType vtkMultiMaterialVolumeMapper::GetTracingMTime()
 {
   // The mapper's modification time as far as tracing goes: an edit that
   // keeps the samples (exposure, tone mapping and the denoised display:
@@ -1220,7 +1220,7 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   this->UpdateEnvironment();
   now.View.Values.push_back(static_cast<double>(in.EnvironmentTime));
   now.View.Depth = ReadDepth(ren, viewport[0], viewport[1], viewport[2], viewport[3]);
-  now.View.TracingTime = this->TracingMTime();
+  now.View.TracingTime = this->GetTracingMTime();
   now.View.Renderer = ren;
   now.View.Volume = vol;
   const int* tiles = ren->GetRenderWindow()->GetTileScale();

@@ -581,6 +581,14 @@ public:
   ///@}
 
   /**
+   * The mapper's modification time as far as the traced image goes: a
+   * change of a setting that keeps the samples (the exposure, the maximum
+   * samples, ...) leaves it as it was. A front end that renders a preview
+   * for a change asks it whether the mapper changed.
+   */
+  vtkMTimeType GetTracingMTime();
+
+  /**
    * How often the tracer ran: a still render that added samples, an
    * interactive preview, or a pass started on the refinement thread. A
    * frame traces at most once, however often VTK calls Render() in it (with
@@ -700,10 +708,9 @@ private:
   bool InputWillExecute();
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
-  vtkMTimeType TracingMTime();
   // Applies `edit` to a setting that leaves the converged image as it is
   // (what DrawFilm reads, how far and how refinement goes, the CPU's
-  // threads and SIMD): the accumulation goes on (TracingMTime).
+  // threads and SIMD): the accumulation goes on (GetTracingMTime).
   template <class Edit>
   void EditKeepingSamples(Edit edit);
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,

@@ -141,7 +141,7 @@ class ClientsTest(SharedServerTest):
             second.get(self.address)
             self.frame(second)
             time.sleep(2)
-            still = self.first.execute_script(FRAME_STATISTICS, True)
+            self.first.execute_script(FRAME_STATISTICS, True)  # kept: the frame the others are compared with
             time.sleep(2)
             refined = self.first.execute_script(FRAME_STATISTICS, False)
             # A vertical drag: the head seen from above, its outline another.
@@ -193,7 +193,6 @@ class ClientsTest(SharedServerTest):
             self.assertRefining("a second tab closed")
         finally:
             second.quit()
-
 
 
 class CyclesTest(SharedServerTest):

@@ -126,11 +126,13 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
     def scene(self):
         """What restarts the refinement when it changes: the view's size,
         each camera, and each of our volumes with its property, mapper and
-        input (their modification times). A request with the scene as it
-        was (a browser that connects and sends the view's size as it is)
-        is answered with the frame as it is, without a preview: a preview
-        would stop the pass in flight and start the accumulation again.
-        Something missed here only costs a change its preview."""
+        input (their modification times; the mapper's as far as tracing
+        goes, which a raised maximum leaves as it was). A request with the
+        scene as it was (a browser that connects and sends the view's size
+        as it is, a setting that keeps the samples) is answered with the
+        frame as it is, without a preview: a preview would stop the pass in
+        flight and start the accumulation again. Something missed here only
+        costs a change its preview."""
         cameras = []
         renderers = self.render_window.GetRenderers()
         renderers.InitTraversal()
@@ -140,8 +142,9 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
                             camera.GetParallelProjection(), camera.GetParallelScale()))
         volumes = []
         for volume in path_traced_volumes(self.render_window):
-            data = volume.GetMapper().GetInput()
-            volumes.append((volume.GetMTime(), volume.GetMapper().GetMTime(), data.GetMTime() if data else 0))
+            mapper = volume.GetMapper()
+            data = mapper.GetInput()
+            volumes.append((volume.GetMTime(), mapper.GetTracingMTime(), data.GetMTime() if data else 0))
         return self.render_window.GetSize(), cameras, volumes
 
     def push_frame(self):
