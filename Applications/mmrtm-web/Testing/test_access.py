@@ -111,7 +111,7 @@ class AccessRulesTest(unittest.TestCase):
         # A cookie whose expiry was moved on keeps its old MAC: refused.
         expires, mac = key.new_cookie_value().split(".")
         self.assertEqual(key.cookie_refusal("%d.%s" % (int(expires) + 3600, mac)), "a cookie of another key")
-        for damaged in ("", ".", "x.y", cookie[:-1], cookie + "0"):
+        for damaged in ("", ".", "x.y", cookie[:-1], cookie + "0", "9" * 5000 + ".x"):
             self.assertIsNotNone(key.cookie_refusal(damaged), damaged)
         self.assertNotEqual(key.cookie_name, other.cookie_name)
         self.assertNotIn(key.token.decode(), key.cookie_name + cookie)
@@ -261,12 +261,14 @@ class KeyTest(unittest.TestCase):
     def test_the_log_holds_neither_keys_nor_the_patient(self):
         get(self.base + "index.html?token=wrong-key-that-must-not-be-logged")
         get(self.base + "index.html")
+        get(self.base + "a%0amade-up%20line")
         time.sleep(0.5)
         with open(self.log_path) as f:
             log = f.read()
         self.assertIn("refused GET /index.html from 127.0.0.1: a wrong key", log)
         self.assertIn("refused GET /index.html from 127.0.0.1: no key", log)
         self.assertNotIn("wrong-key-that-must-not-be-logged", log)
+        self.assertIn("refused GET /a?made-up line from", log, "a path's line break is not a line of the log")
         self.assertEqual(log.count(self.token), 1, "the key only in the printed address")
         for planted in (PATIENT_NAME, PATIENT_ID, "Planted", "4711"):
             self.assertNotIn(planted, log)

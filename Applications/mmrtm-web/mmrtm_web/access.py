@@ -110,9 +110,11 @@ class AccessKey:
 
     def cookie_refusal(self, value):
         """Why the cookie's value lets nobody in, or None when it is valid."""
-        expires, _, mac = value.partition(".")
-        if not expires.isdigit() or not hmac.compare_digest(self.cookie_value(int(expires)).encode(),
-                                                            value.encode("utf-8", "replace")):
+        expires = value.partition(".")[0]
+        # A cookie of this server's has a ten-digit expiry; longer digits
+        # are not even read as a number.
+        if not expires.isdigit() or len(expires) > 12 or not hmac.compare_digest(
+                self.cookie_value(int(expires)).encode(), value.encode("utf-8", "replace")):
             return "a cookie of another key"
         if int(expires) < self.clock():
             return "an expired cookie"
@@ -140,9 +142,11 @@ class AccessKey:
         async def check_access_key(request, handler):
             why = self.refusal(request)
             if why is not None:
-                # The path without the query: a wrong key is not written
-                # to the log either.
-                self.log("mmrtm-web: refused %s %s from %s: %s" % (request.method, request.path, request.remote, why))
+                # The path without the query (a wrong key is not written
+                # to the log either), its unprintable characters replaced
+                # (a path cannot write lines of its own into the log).
+                path = "".join(c if c.isprintable() else "?" for c in request.path)
+                self.log("mmrtm-web: refused %s %s from %s: %s" % (request.method, path, request.remote, why))
                 raise web.HTTPForbidden(text=REFUSAL, headers={hdrs.CACHE_CONTROL: "no-store"})
             if "token" in request.query and request.method == "GET" and \
                     request.headers.get(hdrs.UPGRADE, "").lower() != "websocket":
@@ -153,8 +157,7 @@ class AccessKey:
                 response = web.HTTPFound(request.rel_url.with_query(query))
                 self.set_cookie(response)
                 raise response
-            response = await handler(request)
-            return response
+            return await handler(request)
 
         return check_access_key
 
