@@ -247,7 +247,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   bool ShowedDenoised = false;
   std::string DisplayStatus; // GetDisplayStatus's
 
-  // The last edit that keeps the samples (EditKeepingSamples): the
+  // The last edit that keeps the samples (SetKeepingSamples): the
   // mapper's modification time before it (as GetTracingMTime gave it) and
   // after.
   vtkMTimeType KeptEditBefore = 0, KeptEditAfter = 0;
@@ -542,24 +542,20 @@ void vtkMultiMaterialVolumeMapper::ResetAccumulation()
 
 void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
 {
-  exposure = std::max(0.0, exposure);
-  if (exposure != this->Exposure)
-    this->EditKeepingSamples([&] { this->Exposure = exposure; });
+  this->SetKeepingSamples(this->Exposure, std::max(0.0, exposure));
 }
 
 void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
 {
-  mode = std::clamp(mode, static_cast<int>(AUTOMATIC_TONE_MAPPING), static_cast<int>(FILMIC_TONE_MAPPING));
-  if (mode != this->ToneMapping)
-    this->EditKeepingSamples([&] { this->ToneMapping = mode; });
+  this->SetKeepingSamples(this->ToneMapping,
+    std::clamp(mode, static_cast<int>(AUTOMATIC_TONE_MAPPING), static_cast<int>(FILMIC_TONE_MAPPING)));
 }
 
 void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
 {
   mode = std::clamp(mode, static_cast<int>(DENOISING_OFF), static_cast<int>(DENOISING_ALWAYS));
-  if (mode == this->DenoisingMode)
+  if (!this->SetKeepingSamples(this->DenoisingMode, mode))
     return;
-  this->EditKeepingSamples([&] { this->DenoisingMode = mode; });
   this->Internal->Display.SetMode(mode == DENOISING_AUTO ? mmrtm::DenoisingMode::Auto
       : mode == DENOISING_ALWAYS                         ? mmrtm::DenoisingMode::Always
                                                          : mmrtm::DenoisingMode::Off);
@@ -567,43 +563,33 @@ void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
 
 void vtkMultiMaterialVolumeMapper::SetCpuSimd(int mode)
 {
-  mode = std::clamp(mode, static_cast<int>(CPU_SIMD_AUTO), static_cast<int>(CPU_SIMD_OFF));
-  if (mode != this->CpuSimd)
-    this->EditKeepingSamples([&] { this->CpuSimd = mode; });
+  this->SetKeepingSamples(
+    this->CpuSimd, std::clamp(mode, static_cast<int>(CPU_SIMD_AUTO), static_cast<int>(CPU_SIMD_OFF)));
 }
 
 void vtkMultiMaterialVolumeMapper::SetSamplesPerRender(int samples)
 {
-  samples = std::clamp(samples, 1, 65536);
-  if (samples != this->SamplesPerRender)
-    this->EditKeepingSamples([&] { this->SamplesPerRender = samples; });
+  this->SetKeepingSamples(this->SamplesPerRender, std::clamp(samples, 1, 65536));
 }
 
 void vtkMultiMaterialVolumeMapper::SetMaximumSamples(int samples)
 {
-  samples = std::max(samples, 0);
-  if (samples != this->MaximumSamples)
-    this->EditKeepingSamples([&] { this->MaximumSamples = samples; });
+  this->SetKeepingSamples(this->MaximumSamples, std::max(samples, 0));
 }
 
 void vtkMultiMaterialVolumeMapper::SetNoiseTarget(double target)
 {
-  target = std::clamp(target, 0.0, 1.0);
-  if (target != this->NoiseTarget)
-    this->EditKeepingSamples([&] { this->NoiseTarget = target; });
+  this->SetKeepingSamples(this->NoiseTarget, std::clamp(target, 0.0, 1.0));
 }
 
 void vtkMultiMaterialVolumeMapper::SetNumberOfThreads(int threads)
 {
-  threads = std::clamp(threads, 0, 1024);
-  if (threads != this->NumberOfThreads)
-    this->EditKeepingSamples([&] { this->NumberOfThreads = threads; });
+  this->SetKeepingSamples(this->NumberOfThreads, std::clamp(threads, 0, 1024));
 }
 
 void vtkMultiMaterialVolumeMapper::SetAsynchronousRefinement(vtkTypeBool asynchronous)
 {
-  if (asynchronous != this->AsynchronousRefinement)
-    this->EditKeepingSamples([&] { this->AsynchronousRefinement = asynchronous; });
+  this->SetKeepingSamples(this->AsynchronousRefinement, asynchronous);
 }
 
 void vtkMultiMaterialVolumeMapper::SetLookToVTK()
@@ -618,15 +604,18 @@ void vtkMultiMaterialVolumeMapper::SetLookToFilmic()
   this->SetUnshadedScattering(1);
 }
 
-template <class Edit>
-void vtkMultiMaterialVolumeMapper::EditKeepingSamples(Edit edit)
+template <class T>
+bool vtkMultiMaterialVolumeMapper::SetKeepingSamples(T& setting, T value)
 {
+  if (value == setting)
+    return false;
   Internals& in = *this->Internal;
   const vtkMTimeType before = this->GetTracingMTime();
-  edit();
+  setting = value;
   this->Modified();
   in.KeptEditBefore = before;
   in.KeptEditAfter = this->GetMTime();
+  return true;
 }
 
 vtkMTimeType vtkMultiMaterialVolumeMapper::GetTracingMTime()

@@ -708,11 +708,12 @@ private:
   bool InputWillExecute();
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
-  // Applies `edit` to a setting that leaves the converged image as it is
-  // (what DrawFilm reads, how far and how refinement goes, the CPU's
-  // threads and SIMD): the accumulation goes on (GetTracingMTime).
-  template <class Edit>
-  void EditKeepingSamples(Edit edit);
+  // Sets a setting that leaves the converged image as it is (what DrawFilm
+  // reads, how far and how refinement goes, the CPU's threads and SIMD) to
+  // `value`: the accumulation goes on (GetTracingMTime). False when it
+  // already had that value.
+  template <class T>
+  bool SetKeepingSamples(T& setting, T value);
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;

@@ -112,6 +112,14 @@ class SharedServerTest(unittest.TestCase):
         self.fail("the first browser's view stopped refining after %s (samples %d -> %d)"
                   % (why, start, self.samples(self.first)))
 
+    def drag(self, browser, step, moves=5, release=False):
+        """A drag in `browser`'s 3D view of `moves` moves by `step` (x, y)
+        pixels 50 ms apart, the button left held unless `release`."""
+        drag = ActionChains(browser, duration=0).move_to_element(self.view(browser)).click_and_hold()
+        for _ in range(moves):
+            drag.move_by_offset(*step).pause(0.05)
+        (drag.release() if release else drag).perform()
+
     def view(self, browser):
         return browser.execute_script(
             "return Array.from(document.querySelectorAll('img')).filter(i => i.naturalWidth > 0)"
@@ -145,10 +153,7 @@ class ClientsTest(SharedServerTest):
             time.sleep(2)
             refined = self.first.execute_script(FRAME_STATISTICS, False)
             # A vertical drag: the head seen from above, its outline another.
-            drag = ActionChains(second, duration=0).move_to_element(self.view(second)).click_and_hold()
-            for _ in range(10):
-                drag.move_by_offset(0, 15).pause(0.05)
-            drag.release().perform()
+            self.drag(second, (0, 15), moves=10, release=True)
             time.sleep(3)
             turned = self.first.execute_script(FRAME_STATISTICS, False)
             print("the first browser's view: 2 s of refinement changed it by %.1f levels (outline IoU %.3f), the "
@@ -163,17 +168,11 @@ class ClientsTest(SharedServerTest):
         try:
             second.get(self.address)
             self.frame(second)
-            drag = ActionChains(second, duration=0).move_to_element(self.view(second)).click_and_hold()
-            for _ in range(5):
-                drag.move_by_offset(10, 0).pause(0.05)
-            drag.perform()  # the button is still held
+            self.drag(second, (10, 0))  # the button is still held
             second.refresh()
             self.frame(second)
             self.assertRefining("a reload in the middle of a drag", restarted=True)
-            drag = ActionChains(second, duration=0).move_to_element(self.view(second)).click_and_hold()
-            for _ in range(5):
-                drag.move_by_offset(-10, 0).pause(0.05)
-            drag.perform()
+            self.drag(second, (-10, 0))
         finally:
             second.quit()  # in the middle of the drag
         self.assertRefining("a browser that quit in the middle of a drag", restarted=True)
