@@ -10,7 +10,6 @@ packages=(
   python3-dev              # the Python wrapping of the VTK module
   xvfb xauth
   qt6-base-dev libqt6opengl6-dev libqt6openglwidgets6 libxkbcommon-dev   # the Qt 6 viewer
-  libhwy-dev               # Google Highway: the SIMD CPU code (cuda/simd)
   ninja-build              # the VTK 9.6 SDK and the wheel build (scripts/make-vtk-sdk.sh)
   python3-venv             # .venv: Mitsuba 3, numpy, matplotlib (accuracy checks and charts)
   libllvm16                # Mitsuba's vectorised llvm_ad_rgb variant (Testing/Accuracy)

@@ -77,11 +77,6 @@ options:
   --threads T           CPU threads, 0 for all (default: 0)
   --backend B           auto (CUDA when a device is present, else the CPU; default),
                         cpu, or cuda (an error without a CUDA device)
-  --simd M              the CPU's tracker: auto (the faster for the scene: camera
-                        rays in SIMD lanes on AVX2 and AVX-512 CPUs with the Sobol'
-                        sampler and a pinhole camera, else scalar; default), on
-                        (the lanes where this build and CPU have them) or off
-                        (scalar); the same image to the last bit
   --estimator E         delta (unbiased, default) or raymarch (biased baseline)
   --accelerator A       majorants for delta tracking: none (one global majorant),
                         macrocell (uniform grid), octree (default: the hierarchical
@@ -142,7 +137,6 @@ struct Options {
   mmrtm::DenoisingMode denoise = mmrtm::DenoisingMode::Off;
   json render = json::object();  // overrides of the scene's "render" block
   mmrtm::Backend backend = mmrtm::Backend::Auto;
-  mmrtm::SimdMode simd = mmrtm::SimdMode::Auto;
   bool quiet = false, listSeries = false;
   double noiseTarget = 0;     // 0: render all --spp samples
   bool adaptive = false;      // --sampling adaptive
@@ -220,11 +214,6 @@ Options ParseArguments(int argc, char** argv) {
       const auto backend = mmrtm::ParseBackend(b);
       if (!backend) UsageError("--backend expects auto, cpu or cuda, got '" + b + "'");
       o.backend = *backend;
-    } else if (a == "--simd") {
-      const std::string m = value();
-      const auto simd = mmrtm::ParseSimdMode(m);
-      if (!simd) UsageError("--simd expects auto, on or off, got '" + m + "'");
-      o.simd = *simd;
     } else if (a == "--max-bounces")
       o.render["max_bounces"] = ParseInteger(a, value(), 0, 100000);
     else if (a == "--shadow-scale")
@@ -549,13 +538,13 @@ int Run(const Options& o) {
   };
   if (!o.outputDenoiserInputs.empty() && rs.samplesPerPixel < 2)
     throw mmrtm::InputError("--output-denoiser-inputs needs 2 or more samples per pixel (the even and odd halves)");
-  std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note, o.simd);
+  std::unique_ptr<mmrtm::Renderer> renderer = mmrtm::MakeRenderer(o.backend, rs.threads, note);
   mmrtm::Film film(rs.width, rs.height);
   if (denoiser || !o.outputDenoiserInputs.empty()) film.TrackDenoiserInputs();
   mmrtm::TraceCounters counters;
   if (!o.quiet)
     std::fprintf(stderr, "%d x %d, %d spp, %s, %s, majorant %.4g /mm\n", rs.width, rs.height, rs.samplesPerPixel,
-                 renderer->Description(view).c_str(),
+                 renderer->Description().c_str(),
                  rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "ray marching" : "delta tracking",
                  view.majorants.globalMajorant);
   ProgressBar bar(!o.quiet);
@@ -632,7 +621,7 @@ int Run(const Options& o) {
         {"noise_target", o.noiseTarget > 0 ? json(o.noiseTarget) : json(nullptr)},
         {"stopped_on", reachedTarget ? "noise_target" : "spp"},
         {"threads", rs.threads > 0 ? rs.threads : (int)std::thread::hardware_concurrency()},
-        {"backend", renderer->Description(view)},
+        {"backend", renderer->Description()},
         {"seed", rs.integrator.seed},
         {"estimator", rs.integrator.estimator == mmrtm::Estimator::RayMarching ? "raymarch" : "delta"},
         {"shadow_extinction_scale", rs.integrator.shadowExtinctionScale},

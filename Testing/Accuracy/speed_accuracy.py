@@ -4,7 +4,7 @@ samples per pixel, for delta tracking with each accelerator and for ray
 marching at several step sizes, on every reference scene.
 
     Testing/Accuracy/speed_accuracy.py [--max-spp N] [--only NAME ...]
-        [--issue-binary OLD/bin/mmrtm-render]
+        [--baseline-binary OLD/bin/mmrtm-render]
 
 Needs the references of make_references.py. Writes
 Documentation/images/speed_accuracy_NAME.png and the numbers to
@@ -15,8 +15,8 @@ measured render's own variance out as well: what remains is its bias (about
 0 for the unbiased estimators, a plateau for ray marching). Every render uses the
 unbiased shadow rays (--shadow-scale 1), as the references do.
 
-With --issue-binary (a build of c669328, the commit issue 15 was filed on;
-time_to_error.py's help says how to build it), that renderer is drawn too,
+With --baseline-binary (a build of c669328, the baseline of the light
+sampling and Sobol' work; time_to_error.py's help says how to build it), that renderer is drawn too,
 as "before", and the table's speed-ups are against it; without it, against
 today's octree with one light chosen uniformly and independent numbers.
 """
@@ -32,7 +32,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import mmrtm_accuracy as acc  # noqa: E402
 
 SEED = 7  # differs from make_references.REFERENCE_SEED: independent noise
-ISSUE_BUILD = "when issue 15 was filed (c669328)"
+BASELINE_BUILD = "when issue 15 was filed (c669328)"  # the label stored results carry
 ONE_LIGHT = "delta, octree, one light chosen, independent numbers"
 DEFAULT = "delta, octree (default)"
 
@@ -41,8 +41,8 @@ METHODS = [
     ("delta, no accelerator", ["--accelerator", "none"], "tab:gray", "-"),
     ("delta, macrocell", ["--accelerator", "macrocell"], "tab:blue", "-"),
     (DEFAULT, ["--accelerator", "octree"], "tab:green", "-"),
-    # The estimator of before issue 15's changes to next-event estimation and
-    # sampling (one light chosen uniformly, independent numbers), on today's code.
+    # The estimator of the baseline's next-event estimation and sampling (one
+    # light chosen uniformly, independent numbers), on today's code.
     (ONE_LIGHT, ["--accelerator", "octree", "--light-sampling", "one", "--sampler", "independent"], "black", "-."),
     ("delta, octree, adaptive sampling", ["--accelerator", "octree", "--sampling", "adaptive"], "tab:cyan", "-"),
     ("delta, octree-voxelmax", ["--accelerator", "octree-voxelmax"], "tab:olive", "--"),
@@ -53,25 +53,25 @@ METHODS = [
 ]
 
 
-def methods(issue_binary):
-    """(label, options, colour, style, binary): METHODS, and first the build
-    issue 15 was filed on when `issue_binary` is given (its path; the charts
-    and the table pass True when stored results have it)."""
+def methods(baseline_binary):
+    """(label, options, colour, style, binary): METHODS, and first the
+    baseline build when `baseline_binary` is given (its path; the charts and
+    the table pass True when stored results have it)."""
     rows = [(label, options, colour, style, None) for label, options, colour, style in METHODS]
-    if issue_binary:
-        rows.insert(0, (ISSUE_BUILD, [], "magenta", "-.", issue_binary))
+    if baseline_binary:
+        rows.insert(0, (BASELINE_BUILD, [], "magenta", "-.", baseline_binary))
     return rows
 
 
 def before_label(result):
-    """The method the speed-ups are against: the issue's build if it was measured."""
-    for label in (ISSUE_BUILD, ONE_LIGHT, DEFAULT):
+    """The method the speed-ups are against: the baseline build if it was measured."""
+    for label in (BASELINE_BUILD, ONE_LIGHT, DEFAULT):
         if result["methods"].get(label):
             return label
     raise KeyError("no method to compare with")
 
 
-def measure(name, max_spp, size, budget, issue_binary=None):
+def measure(name, max_spp, size, budget, baseline_binary=None):
     ref = acc.load_reference(name)
     if ref is None:
         raise SystemExit(f"no reference for {name} in {acc.REFERENCE_DIR}: run make_references.py first")
@@ -82,7 +82,7 @@ def measure(name, max_spp, size, budget, issue_binary=None):
               "methods": {}}
     ladder = [s for s in (1, 2, 4, 8, 16, 32, 64, 128, 256, 512) if s <= max_spp]
     # Every method doubles its samples up to max_spp, or until one render would exceed the time budget.
-    for label, options, _, _, binary in methods(issue_binary):
+    for label, options, _, _, binary in methods(baseline_binary):
         rows = []
         for spp in ladder:
             r = acc.render(acc.SCENES[name]["args"], size, size, spp, seed=SEED,
@@ -104,7 +104,7 @@ def measure(name, max_spp, size, budget, issue_binary=None):
 
 def chart(name, result, path):
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.4))
-    for label, _, colour, style, _ in methods(ISSUE_BUILD in result["methods"]):
+    for label, _, colour, style, _ in methods(BASELINE_BUILD in result["methods"]):
         rows = result["methods"].get(label)
         if not rows:
             continue
@@ -138,7 +138,7 @@ def chart(name, result, path):
 
 def table(results):
     """Markdown: per scene and method, the last measured rung, and the time each
-    method needs to reach the error of the renderer before issue 15 (its build,
+    method needs to reach the error of the baseline renderer (its build,
     or else one light chosen uniformly and independent numbers on the octree)
     at its last rung (64 spp): t e^2 / e0^2, valid
     while the error is still falling as 1 / sqrt(samples); a method whose
@@ -147,7 +147,7 @@ def table(results):
              "|---|---|---|---|---|---|---|---|"]
     for name, result in results.items():
         target = result["methods"][before_label(result)][-1]
-        for label, _, _, _, _ in methods(ISSUE_BUILD in result["methods"]):
+        for label, _, _, _, _ in methods(BASELINE_BUILD in result["methods"]):
             rows = result["methods"].get(label)
             if not rows:
                 continue
@@ -172,13 +172,13 @@ def main():
                         help="seconds: a method's samples stop doubling before one render would take longer")
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     parser.add_argument("--charts-only", action="store_true", help="redraw from speed_accuracy.json")
-    parser.add_argument("--issue-binary", help="mmrtm-render built at the commit issue 15 was filed on")
+    parser.add_argument("--baseline-binary", help="mmrtm-render built at the baseline commit, c669328")
     args = parser.parse_args()
     store = acc.REFERENCE_DIR / "speed_accuracy.json"
     results = json.loads(store.read_text()) if store.exists() else {}
     for name in args.only or list(acc.SCENES):
         if not args.charts_only:
-            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE, args.budget, args.issue_binary)
+            results[name] = measure(name, args.max_spp, acc.REFERENCE_SIZE, args.budget, args.baseline_binary)
             store.write_text(json.dumps(results, indent=1))
         if name in results:
             chart(name, results[name], acc.DOC_IMAGES / f"speed_accuracy_{name}.png")

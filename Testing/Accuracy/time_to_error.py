@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""Time to the error that 64 spp gave before issue 15, on the five reference
+"""Time to the error that 64 spp gave at the baseline commit c669328, on the five reference
 scenes, measured: the renderer as it was (one light chosen uniformly,
 uniform sampling, independent random numbers), with next-event estimation
 by resampling, with the Sobol' sampler on top (both the default now), and
 with adaptive sampling on top of that.
 
     Testing/Accuracy/time_to_error.py [--spp 64] [--ladder 4,8,16,32,64,128]
-        [--repeats 2] [--only NAME ...] [--issue-binary OLD/bin/mmrtm-render]
+        [--repeats 2] [--only NAME ...] [--baseline-binary OLD/bin/mmrtm-render]
 
 Needs the references of make_references.py (256 x 256). The target is the
 first method's relative RMSE (against the reference, its own variance
@@ -23,14 +23,14 @@ log error against log time (-0.5 for plain Monte Carlo) beside the
 extrapolation from its 64-spp error that the table used to print.
 Prints a Markdown table and writes MMRTM_REFERENCE_DIR/time_to_error.json.
 
-With --issue-binary, a first method renders with that mmrtm-render: a build
-of the commit on which issue 15 was filed (c669328), the "today" of its
+With --baseline-binary, a first method renders with that mmrtm-render: a build
+of the baseline commit (c669328), the "today" of its
 goal, which lacks the option of later builds and the speed work between:
 
-    git worktree add /tmp/issue15 c669328
-    cmake -S /tmp/issue15 -B /tmp/issue15/build -DCMAKE_BUILD_TYPE=Release -DMMRTM_ENABLE_CUDA=OFF
-    cmake --build /tmp/issue15/build --target mmrtm-render
-    Testing/Accuracy/time_to_error.py --issue-binary /tmp/issue15/build/bin/mmrtm-render
+    git worktree add /tmp/baseline c669328
+    cmake -S /tmp/baseline -B /tmp/baseline/build -DCMAKE_BUILD_TYPE=Release -DMMRTM_ENABLE_CUDA=OFF
+    cmake --build /tmp/baseline/build --target mmrtm-render
+    Testing/Accuracy/time_to_error.py --baseline-binary /tmp/baseline/build/bin/mmrtm-render
 
 The speed-ups are then against that first method.
 """
@@ -84,12 +84,12 @@ def main():
     parser.add_argument("--ladder", default="4,8,16,32,64,128", help="sample counts every method renders")
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
-    parser.add_argument("--issue-binary", help="mmrtm-render built at the commit issue 15 was filed on")
+    parser.add_argument("--baseline-binary", help="mmrtm-render built at the baseline commit, c669328")
     args = parser.parse_args()
     ladder = sorted({int(v) for v in args.ladder.split(",")} | {args.spp})
     methods = [(label, options, None) for label, options in METHODS]
-    if args.issue_binary:
-        methods.insert(0, ("when issue 15 was filed (c669328)", [], args.issue_binary))
+    if args.baseline_binary:
+        methods.insert(0, ("when issue 15 was filed (c669328)", [], args.baseline_binary))  # the stored label
     results = {}
     lines = ["| scene | method | target error (the first row's at --spp) | time to it (measured) | "
              "speed-up | extrapolated from 64 spp | slope of log error / log time |",

@@ -8,6 +8,7 @@ change that only makes samples cheaper.
 
     .venv/bin/python Testing/Benchmarks/bench_binaries_ab.py A/bin/mmrtm-render B/bin/mmrtm-render \\
         [--size 128] [--spp 32] [--repeats 3] [--only NAME ...] [--b-option=--sampler --b-option=independent]
+        [--a-option=...]
         [--references]
 
 Needs the shared data (MMRTM_SHARED_DATA_DIR or ../shared/data). With
@@ -35,6 +36,8 @@ def main():
     parser.add_argument("--spp", type=int, default=32)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
+    parser.add_argument("--a-option", action="append", default=[],
+                        help="an option for A only (repeat for several), e.g. one B does not have")
     parser.add_argument("--b-option", action="append", default=[],
                         help="an option for B only (repeat for several), e.g. one A does not have")
     parser.add_argument("--references", action="store_true",
@@ -54,7 +57,7 @@ def main():
             for seed in seeds:
                 for key in ("a", "b"):
                     r = acc.render(acc.SCENES[name]["args"], size, size, args.spp, seed=seed,
-                                   extra=["--shadow-scale", "1", *(args.b_option if key == "b" else [])],
+                                   extra=["--shadow-scale", "1", *(args.b_option if key == "b" else args.a_option)],
                                    binary=getattr(args, key))
                     times[key].append(r.seconds)
                     stats[key] = r.stats

@@ -1,6 +1,6 @@
 """Benchmark (not a test): volumes from 0.1 to 8 GiB, loaded, summarised and
 rendered by mmrtm-render and by the VTK mapper, with the peak resident
-memory of each process against the voxel bytes (issue 35's table).
+memory of each process against the voxel bytes (Documentation/performance.md's table).
 
 The volumes are the head CT (ct_head_cranium, 256 x 256 x 108 int16) tiled
 along each axis into a raw int16 NRRD, written at run time under --scratch

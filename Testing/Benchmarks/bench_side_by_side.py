@@ -4,10 +4,7 @@ one sample per pixel per render, with the same vtkVolumeProperty (shading
 on), camera, lights and window (512 x 512). Three volumes: the head CT, the
 chest CT DICOM series and the bonsai. For each, the median seconds of a
 frame over several frames of each mapper (the first frame of each, which
-builds its structures, is timed apart), and the ratio ours / VTK's; ours
-also with the CPU's scalar tracker forced (`SetCpuSimdToOff`, "scalar";
-ours is the default, auto, which takes the SIMD lanes where they are
-faster: the backend descriptions in --json say which ran). The
+builds its structures, is timed apart), and the ratio ours / VTK's. The
 mappers alternate frame by frame, so that the noise of a shared machine
 falls on all alike.
 
@@ -94,9 +91,6 @@ class Pair:
         self.fixed.SetInputData(self.image)
         self.fixed.SetAutoAdjustSampleDistances(0)  # VTK's full-quality still frame
         self.ours = self.our_mapper()
-        # The same with the CPU's scalar tracker (--simd off).
-        self.scalar = self.our_mapper()
-        self.scalar.SetCpuSimdToOff()
         self.volume = vtkVolume()
         self.volume.SetProperty(self.property)
         self.renderer = vtkRenderer()
@@ -145,33 +139,27 @@ def main():
     args = parser.parse_args()
     volumes = {"head": head_ct, "chest": chest_ct, "bonsai": bonsai}
     results = {}
-    print("%-7s %12s %12s %12s %12s %7s %12s %7s" % ("volume", "VTK first", "ours first", "VTK frame", "ours frame",
-                                                     "ratio", "scalar frame", "ratio"))
+    print("%-7s %12s %12s %12s %12s %7s" % ("volume", "VTK first", "ours first", "VTK frame", "ours frame", "ratio"))
     for name in args.volumes.split(","):
         reader, functions = volumes[name]()
         pair = Pair(reader, functions, args.size)
         first_fixed = pair.frame(pair.fixed)
         first_ours = pair.frame(pair.ours)
-        pair.frame(pair.scalar)
-        fixed, ours, scalar = [], [], []
+        fixed, ours = [], []
         for _ in range(args.frames):
             fixed.append(pair.frame(pair.fixed))
             ours.append(pair.frame(pair.ours))  # adds one sample per pixel (nothing changed)
-            scalar.append(pair.frame(pair.scalar))
         if args.images:
             os.makedirs(args.images, exist_ok=True)
             for mapper, label in ((pair.fixed, "vtk"), (pair.ours, "ours")):
                 pair.frame(mapper)
                 pair.save(os.path.join(args.images, "%s-%s.png" % (name, label)))
-        f, o, s = statistics.median(fixed), statistics.median(ours), statistics.median(scalar)
+        f, o = statistics.median(fixed), statistics.median(ours)
         results[name] = {"dimensions": list(pair.image.GetDimensions()), "vtk_first_s": first_fixed,
                          "ours_first_s": first_ours, "vtk_frame_s": f, "ours_frame_s": o, "ratio": o / f,
-                         "scalar_frame_s": s, "scalar_ratio": s / f,
                          "ours_samples": pair.ours.GetAccumulatedSamples(),
-                         "backend": pair.ours.GetBackendDescription(),
-                         "scalar_backend": pair.scalar.GetBackendDescription()}
-        print("%-7s %11.3fs %11.3fs %11.3fs %11.3fs %7.2f %11.3fs %7.2f" % (name, first_fixed, first_ours, f, o,
-                                                                           o / f, s, s / f))
+                         "backend": pair.ours.GetBackendDescription()}
+        print("%-7s %11.3fs %11.3fs %11.3fs %11.3fs %7.2f" % (name, first_fixed, first_ours, f, o, o / f))
         sys.stdout.flush()
     if args.json:
         with open(args.json, "w") as out:

@@ -11,7 +11,7 @@ bench_binaries_ab.py for the time). Only the render part is counted
 build; one thread, shadow scale 1.
 
     .venv/bin/python Testing/Benchmarks/callgrind_binaries_ab.py A/bin/mmrtm-render B/bin/mmrtm-render \\
-        [--size 48] [--spp 8] [--simd auto|on|off] [--only NAME ...]
+        [--size 48] [--spp 8] [--a-option=--simd --a-option=off] [--only NAME ...]
 
 Needs valgrind and the shared data (MMRTM_SHARED_DATA_DIR or ../shared/data).
 Takes about five minutes at the defaults.
@@ -30,14 +30,12 @@ import mmrtm_accuracy as acc  # noqa: E402
 RENDER_PART = "mmrtm::CpuRenderer::RenderRanges*::{lambda(int)#1}::operator()*"
 
 
-def count(binary, args, size, spp, simd, image):
+def count(binary, args, size, spp, options, image):
     """The render part's instructions, and the linear image in `image`."""
     cmd = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", f"--toggle-collect={RENDER_PART}",
            str(binary), *map(str, args), "--width", str(size), "--height", str(size), "--spp", str(spp),
            "--seed", "3", "--threads", "1", "--backend", "cpu", "--shadow-scale", "1", "--quiet",
-           "--output", str(image.with_suffix(".png")), "--output-linear", str(image)]
-    if simd:  # builds from before the SIMD tracker have no --simd
-        cmd += ["--simd", simd]
+           "--output", str(image.with_suffix(".png")), "--output-linear", str(image), *options]
     done = subprocess.run(cmd, capture_output=True, text=True)
     refs = re.search(r"I\s+refs:\s+([\d,]+)", done.stderr)
     if done.returncode != 0 or not refs:
@@ -51,8 +49,9 @@ def main():
     parser.add_argument("b")
     parser.add_argument("--size", type=int, default=48)
     parser.add_argument("--spp", type=int, default=8)
-    parser.add_argument("--simd", choices=["auto", "on", "off"],
-                        help="the CPU tracker of both builds (mmrtm-render --simd; default: theirs)")
+    parser.add_argument("--a-option", action="append", default=[],
+                        help="an option for A only (repeat for several), e.g. one B does not have")
+    parser.add_argument("--b-option", action="append", default=[], help="an option for B only")
     parser.add_argument("--only", nargs="*", choices=sorted(acc.SCENES))
     args = parser.parse_args()
     print("| scene | A instructions | B instructions | B / A | images |")
@@ -60,8 +59,8 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.only or list(acc.SCENES):
             images = [Path(tmp) / f"{name}_{key}.pfm" for key in ("a", "b")]
-            a, b = (count(binary, acc.SCENES[name]["args"], args.size, args.spp, args.simd, image)
-                    for binary, image in zip((args.a, args.b), images))
+            a, b = (count(binary, acc.SCENES[name]["args"], args.size, args.spp, options, image)
+                    for binary, options, image in zip((args.a, args.b), (args.a_option, args.b_option), images))
             same = images[0].read_bytes() == images[1].read_bytes()
             print(f"| {acc.SCENES[name]['title']} | {a / 1e6:.1f} M | {b / 1e6:.1f} M | {b / a:.3f} | "
                   f"{'identical' if same else 'differ'} |", flush=True)

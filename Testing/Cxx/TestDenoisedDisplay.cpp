@@ -349,7 +349,7 @@ TEST_F(DenoisedDisplayOnReferenceScenes, AutoNeverShowsAnImageFartherThanTheFilm
            for (RGB& p : image.pixels) p = RGB(p.r * 1.05f, p.g, p.b * 0.95f);
          return out;
        }}};
-  const CpuRenderer renderer(0, SimdMode::Auto);
+  const CpuRenderer renderer(0);
   int shownDenoised = 0, shownFilm = 0;
   for (const std::string& name : test::ReferenceSceneNames()) {
     Scene scene = test::LoadReferenceScene(name, kSize, kSize);

@@ -1,6 +1,6 @@
 // The denoised display's inputs, gathered with the samples
 // (FilmView::denoiserInputs, Film::DenoiserImages): the radiance is the same
-// to the bit with them kept or not, on the scalar and the SIMD trackers;
+// to the bit with them kept or not;
 // where camera rays first collide with a dense slab the albedo guide is the
 // material's and the normal faces the camera; where they escape the guide
 // is the background, clamped, and no normal; the two halves are the even
@@ -26,11 +26,11 @@ Scene MakeSlabScene(RGB background) {
   return scene;
 }
 
-Film Render(const Scene& scene, int spp, bool inputs, int threads = 1, SimdMode simd = SimdMode::Off) {
+Film Render(const Scene& scene, int spp, bool inputs, int threads = 1) {
   const SceneView view = const_cast<Scene&>(scene).Build();
   Film film(scene.render.width, scene.render.height);
   if (inputs) film.TrackDenoiserInputs();
-  CpuRenderer(threads, simd).Render(view, film, spp);
+  CpuRenderer(threads).Render(view, film, spp);
   return film;
 }
 
@@ -50,10 +50,7 @@ TEST(DenoiserInputs, TheRadianceIsTheSameToTheBitWithThemOrWithout) {
     return std::sin(0.7f * i) * std::cos(0.5f * j) + 0.2f * k > 0.3f ? 1.f : 0.f;
   }));
   lit.render.width = lit.render.height = 24;
-  for (const SimdMode simd : {SimdMode::Off, SimdMode::On}) {
-    SCOPED_TRACE(simd == SimdMode::On ? "SIMD" : "scalar");
-    ExpectSameRadiance(Render(lit, 6, false, 1, simd), Render(lit, 6, true, 1, simd));
-  }
+  ExpectSameRadiance(Render(lit, 6, false), Render(lit, 6, true));
 }
 
 TEST(DenoiserInputs, AlbedoAndFaceNormalOnASlabAndTheBackgroundBeside) {
@@ -98,7 +95,7 @@ TEST(DenoiserInputs, TheHalvesAreTheEvenAndTheOddSamples) {
   std::vector<Film> single;
   Film growing(16, 16);
   for (int n = 0; n < 5; ++n) {
-    CpuRenderer(1, SimdMode::Off).Render(view, growing, 1);
+    CpuRenderer(1).Render(view, growing, 1);
     single.push_back(growing);
   }
   for (int y = 0; y < 16; ++y)

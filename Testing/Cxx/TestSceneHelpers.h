@@ -68,7 +68,7 @@ inline Scene MakeMediumScene(HostVolume volume, float density, RGB albedo, float
   return s;
 }
 
-// A lit scene over `volume` (TestDeterminism's, TestSimdBackend's): the
+// A lit scene over `volume` (TestDeterminism's): the
 // medium of MakeMediumScene with albedo (0.9, 0.7, 0.5) and g 0.3, half the
 // collisions on the surface BSDF, a sky and a sun, the shadow scale 0.8.
 inline Scene MakeLitSurfaceScene(HostVolume volume) {

@@ -8,8 +8,7 @@ Builds the project in BUILD_DIR with -DMMRTM_PLANTED_DEFECTS=ON (the
 defects compiled in, CPU only, nothing but the checks' targets), runs the
 checks once with no defect (all must pass, or the table means nothing),
 then once per defect with MMRTM_PLANTED_DEFECT=<name>, in CHECKS' order,
-until one fails; that check runs again with the CPU's SIMD lanes
-(MMRTM_CPU_SIMD=on) and must fail there too. Prints the table (defect, the check that caught it, the
+until one fails. Prints the table (defect, the check that caught it, the
 first line of its failure: the score) and writes it as Markdown with
 --table. Exits 1 if a defect is caught by nothing or a check fails without
 one.
@@ -33,7 +32,6 @@ from pathlib import Path
 # denoised display's check on the reference scenes takes about a minute.
 CHECKS = [
     ("TestTransferFunctions", "TestTransferFunctions", [], False),
-    ("TestSimdBackend", "TestSimdBackend", [], False),
     ("TestAdaptiveSampling AdaptiveFilm", "TestAdaptiveSampling", ["--gtest_filter=AdaptiveFilm.*"], False),
     ("TestBSDF lobes and phase", "TestBSDF",
      ["--gtest_filter=BSDF.EachLobesAlbedoIsItsIntegral:BSDF.SampledAlbedoIsTheIntegral:Phase.*"], False),
@@ -53,7 +51,7 @@ CHECKS = [
 
 DEFECTS = ["volume_albedo", "diffuse_lobe", "specular_lobe", "phase_sign", "majorant_low", "minorant_high",
            "shadow_last_segment", "light_weights", "environment_pdf", "mapper_color_refit", "label_swap",
-           "film_variance", "simd_extinction", "denoise_variance", "vtk_extinction", "vtk_color",
+           "film_variance", "denoise_variance", "vtk_extinction", "vtk_color",
            "vtk_gradient_opacity", "vtk_gradient_magnitude", "vtk_component_weight", "vtk_dependent_rgb",
            "vtk_label_functions", "vtk_label_material", "vtk_ambient", "vtk_diffuse", "vtk_specular_power"]
 
@@ -86,13 +84,11 @@ def first_failure(output):
     return lines[-1].strip()[:300] if lines else "(no output)"
 
 
-def run_check(build, headless, check, defect, simd="off"):
-    """Runs a check with the CPU's tracker `simd` (MMRTM_CPU_SIMD: off, the
-    scalar one, or on, the SIMD lanes)."""
+def run_check(build, headless, check, defect):
+    """Runs a check, with `defect` planted (None: none)."""
     name, exe, args, needs_x = check
     env = dict(os.environ)
     env.pop("MMRTM_PLANTED_DEFECT", None)
-    env["MMRTM_CPU_SIMD"] = simd
     if defect:
         env["MMRTM_PLANTED_DEFECT"] = defect
     command = [str(Path(build) / "bin" / exe), *args]
@@ -118,41 +114,35 @@ def main():
 
     ok = True
     for check in CHECKS:
-        for simd in ("off", "on"):
-            passed, output, seconds = run_check(args.build, headless, check, None, simd)
-            print(f"no defect: {check[0]} (simd {simd}): {'passes' if passed else 'FAILS'} ({seconds:.1f} s)",
-                  flush=True)
-            if not passed:
-                print(output[-3000:])
-                ok = False
+        passed, output, seconds = run_check(args.build, headless, check, None)
+        print(f"no defect: {check[0]}: {'passes' if passed else 'FAILS'} ({seconds:.1f} s)", flush=True)
+        if not passed:
+            print(output[-3000:])
+            ok = False
     if not ok:
         print("a check fails without a planted defect: fix that first")
         return 1
 
     rows = []
     for defect in args.defect or DEFECTS:
-        caught, lanes = None, None
+        caught = None
         for check in CHECKS:
             passed, output, seconds = run_check(args.build, headless, check, defect)
             if not passed:
                 caught = (check[0], first_failure(output), seconds)
-                # The same check with the CPU's SIMD lanes must catch it too.
-                lanes = not run_check(args.build, headless, check, defect, "on")[0]
                 break
-        rows.append((defect, caught, lanes))
-        print(f"{defect}: " + (f"caught by {caught[0]} ({caught[2]:.1f} s; with SIMD lanes: "
-                               f"{'caught' if lanes else 'MISSED'}): {caught[1]}" if caught else "NOT CAUGHT"),
+        rows.append((defect, caught))
+        print(f"{defect}: " + (f"caught by {caught[0]} ({caught[2]:.1f} s): {caught[1]}" if caught else "NOT CAUGHT"),
               flush=True)
 
-    table = ["| planted defect | caught by | with SIMD lanes | its score (the first failure) |", "|---|---|---|---|"]
-    for defect, caught, lanes in rows:
+    table = ["| planted defect | caught by | its score (the first failure) |", "|---|---|---|"]
+    for defect, caught in rows:
         score = caught[1].replace("|", "/") if caught else ""
-        table.append(f"| `{defect}` | {caught[0] if caught else '**nothing**'} | "
-                     f"{'caught' if lanes else '**missed**'} | {score} |")
+        table.append(f"| `{defect}` | {caught[0] if caught else '**nothing**'} | {score} |")
     print("\n".join(table))
     if args.table:
         Path(args.table).write_text("\n".join(table) + "\n")
-    missed = [d for d, c, lanes in rows if not c or not lanes]
+    missed = [d for d, c in rows if not c]
     if missed:
         print(f"not caught: {', '.join(missed)}")
         return 1

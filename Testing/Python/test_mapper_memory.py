@@ -26,8 +26,8 @@ from mmrtm import vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
 DATA = os.environ["MMRTM_SHARED_DATA_DIR"]
 BACKGROUND = (0.1, 0.1, 0.15)
-# Issue 35: beyond what the caller holds, the mapper's proxies, label maps
-# and grid may take at most 0.15 x the caller's voxel bytes.
+# Beyond what the caller holds, the mapper's proxies, label maps and grid
+# may take at most 0.15 x the caller's voxel bytes.
 ALLOWED_EXTRA = 0.15
 
 
@@ -119,7 +119,7 @@ class View:
 class InPlaceVoxelsTest(unittest.TestCase):
     def test_peak_memory_holds_no_copy_of_the_callers_voxels(self):
         # What this catches: a copy of the caller's voxels (1.0 x their
-        # bytes, as ImageDataToHostVolume made before issue 35), or any
+        # bytes, as ImageDataToHostVolume once made), or any
         # other volume-sized buffer per render, such as a float proxy of the
         # int16 input (2.0 x). Fixed costs (the GL context, the thread pool,
         # the film) are paid on a small volume first, so that what is

@@ -454,9 +454,17 @@ void Add2DMaterials(vtkImageData* table, vtkVolumeProperty* property, int compon
 namespace
 {
 
-// The density factor that keeps the other materials off the labels that
-// have functions (TranslateMaterials).
-const char* const kLabelGate = "label map: labels with functions";
+// The translation's transfer function of `type` over the label proxy
+// (TranslateMaterials makes at most one of each: the labels' material
+// selector, an MDPTF, and the gate that keeps the other materials off the
+// labels that have functions, a CPCTF), or -1.
+int LabelTransferFunction(const Scene& scene, int labelProxy, TFType type)
+{
+  for (size_t i = 0; i < scene.tfs.size(); ++i)
+    if (scene.tfs[i].proxy == labelProxy && scene.tfs[i].type == type)
+      return static_cast<int>(i);
+  return -1;
+}
 
 // Returns how many function node values were not finite.
 int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLayout& proxies,
@@ -544,7 +552,7 @@ int TranslateMaterials(vtkVolumeProperty* property, int component, const ProxyLa
   // 1 at every other value (0, and labels without functions, which VTK
   // classifies with the component's functions).
   TransferFunctionDesc gate;
-  gate.where = kLabelGate;
+  gate.where = "label map: labels with functions";
   gate.type = TFType::CPCTF;
   gate.proxy = proxies.labels;
   gate.channels = 1;
@@ -617,15 +625,17 @@ void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property,
   // A look follows the one label rule (a hidden label shows the volume
   // property): the label leaves the gate that VTK's label functions put it
   // in.
-  for (TransferFunctionDesc& gate : scene.tfs)
-    if (gate.where == kLabelGate)
-      for (size_t i = 0; i + 1 < gate.values.size(); ++i)
-        if (gate.keys[2 * i] == label - 0.5f)
-        {
-          gate.keys.erase(gate.keys.begin() + 2 * i, gate.keys.begin() + 2 * i + 2);
-          gate.values.erase(gate.values.begin() + i);
-          break;
-        }
+  if (const int g = LabelTransferFunction(scene, proxies.labels, TFType::CPCTF); g >= 0)
+  {
+    TransferFunctionDesc& gate = scene.tfs[g];
+    for (size_t i = 0; i + 1 < gate.values.size(); ++i)
+      if (gate.keys[2 * i] == label - 0.5f)
+      {
+        gate.keys.erase(gate.keys.begin() + 2 * i, gate.keys.begin() + 2 * i + 2);
+        gate.values.erase(gate.values.begin() + i);
+        break;
+      }
+  }
   if (const int index = scene.MaterialIndex(m.name); index >= 0)
   {
     scene.materials[index] = std::move(m); // the property's label functions made it: the selector has it
@@ -633,10 +643,8 @@ void SetLabelLook(int label, const LabelLook& look, vtkVolumeProperty* property,
   }
   // The label selector (SetMaterialsFromProperty puts it first), made when
   // the property has no label functions.
-  TransferFunctionDesc* selector = nullptr;
-  for (int i : scene.selectors)
-    if (scene.tfs[i].where == "label map")
-      selector = &scene.tfs[i];
+  const int s = LabelTransferFunction(scene, proxies.labels, TFType::MDPTF);
+  TransferFunctionDesc* selector = s >= 0 ? &scene.tfs[s] : nullptr;
   if (!selector)
   {
     TransferFunctionDesc tf;

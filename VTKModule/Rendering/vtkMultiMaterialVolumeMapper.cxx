@@ -141,7 +141,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
 {
   mmrtm::Scene Scene;
   std::unique_ptr<mmrtm::Renderer> Renderer;
-  int RendererBackend = -1, RendererThreads = -1, RendererCpuSimd = -1;
+  int RendererBackend = -1, RendererThreads = -1;
   std::unique_ptr<mmrtm::Film> Film;
   std::string BackendDescription;
   vtkNew<vtkMatrix4x4> Matrix; // the volume's matrix at the last render
@@ -561,12 +561,6 @@ void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
                                                          : mmrtm::DenoisingMode::Off);
 }
 
-void vtkMultiMaterialVolumeMapper::SetCpuSimd(int mode)
-{
-  this->SetKeepingSamples(
-    this->CpuSimd, std::clamp(mode, static_cast<int>(CPU_SIMD_AUTO), static_cast<int>(CPU_SIMD_OFF)));
-}
-
 void vtkMultiMaterialVolumeMapper::SetSamplesPerRender(int samples)
 {
   this->SetKeepingSamples(this->SamplesPerRender, std::clamp(samples, 1, 65536));
@@ -623,9 +617,8 @@ vtkMTimeType vtkMultiMaterialVolumeMapper::GetTracingMTime()
   // The mapper's modification time as far as tracing goes: an edit that
   // keeps the samples (exposure, tone mapping and the denoised display:
   // only the drawing reads them; the samples per render, the maximum
-  // samples and the noise target: how far refinement goes; the threads,
-  // the SIMD switch and the asynchronous refinement: the same film either
-  // way) with nothing modified after it leaves the time it had before, so
+  // samples and the noise target: how far refinement goes; the threads
+  // and the asynchronous refinement: the same film either way) with nothing modified after it leaves the time it had before, so
   // the accumulation goes on.
   const vtkMTimeType t = this->GetMTime();
   return t == this->Internal->KeptEditAfter ? this->Internal->KeptEditBefore : t;
@@ -1448,20 +1441,15 @@ mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProp
 void vtkMultiMaterialVolumeMapper::UpdateRenderer()
 {
   Internals& in = *this->Internal;
-  if (in.Renderer && in.RendererBackend == this->Backend && in.RendererThreads == this->NumberOfThreads &&
-    in.RendererCpuSimd == this->CpuSimd)
+  if (in.Renderer && in.RendererBackend == this->Backend && in.RendererThreads == this->NumberOfThreads)
     return;
   const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
     : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
                                                       : mmrtm::Backend::Auto;
   in.Renderer = mmrtm::MakeRenderer(
-    backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); },
-    this->CpuSimd == CPU_SIMD_ON      ? mmrtm::SimdMode::On
-      : this->CpuSimd == CPU_SIMD_OFF ? mmrtm::SimdMode::Off
-                                      : mmrtm::SimdMode::Auto);
+    backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); });
   in.RendererBackend = this->Backend;
   in.RendererThreads = this->NumberOfThreads;
-  in.RendererCpuSimd = this->CpuSimd;
   in.BackendDescription = in.Renderer->Description();
 }
 
@@ -1481,8 +1469,8 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
   Internals& in = *this->Internal;
   const auto buildStart = std::chrono::steady_clock::now();
   const mmrtm::SceneView sceneView = this->BuildScene();
-  if (in.Renderer)
-    in.BackendDescription = in.Renderer->Description(sceneView);
+  if (in.Renderer) // a CUDA backend that fell back to the CPU says so
+    in.BackendDescription = in.Renderer->Description();
   in.CountGridWork();
   if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning) // once per change, not per render
   {
@@ -2027,7 +2015,6 @@ void vtkMultiMaterialVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "Backend: " << this->Backend << "\n";
-  os << indent << "CpuSimd: " << this->CpuSimd << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "ShadowExtinctionScale: " << this->ShadowExtinctionScale << "\n";
   os << indent << "NoiseTarget: " << this->NoiseTarget << "\n";

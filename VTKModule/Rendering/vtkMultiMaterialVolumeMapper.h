@@ -22,8 +22,8 @@
  * - the exposure, the tone mapping, the denoised display: the accumulated
  *   samples are drawn again, not restarted;
  * - the samples per render, the maximum samples, the noise target, the
- *   threads, the CPU's SIMD, asynchronous refinement: the accumulation goes
- *   on from the samples it has (none of them changes the converged image);
+ *   threads, asynchronous refinement: the accumulation goes on from the
+ *   samples it has (none of them changes the converged image);
  * - nothing changed: samples are added.
  *
  * The volume's matrix (vtkProp3D) is honoured, so oblique orientations and
@@ -145,28 +145,6 @@ public:
   void SetBackendToCUDA() { this->SetBackend(CUDA); }
   ///@}
 
-  enum CpuSimdModes
-  {
-    CPU_SIMD_AUTO = 0,
-    CPU_SIMD_ON = 1,
-    CPU_SIMD_OFF = 2
-  };
-  ///@{
-  /**
-   * The CPU's tracker: AUTO (default) the faster for the scene (camera rays
-   * in SIMD lanes on AVX2 and AVX-512 CPUs with the Sobol' sampler and a
-   * pinhole camera, else scalar), ON the lanes where this build and CPU
-   * have them, OFF the scalar one. The same image to the last bit either
-   * way, so a change keeps the accumulation. GetBackendDescription says
-   * which rendered. mmrtm-render's --simd.
-   */
-  virtual void SetCpuSimd(int mode);
-  vtkGetMacro(CpuSimd, int);
-  void SetCpuSimdToAuto() { this->SetCpuSimd(CPU_SIMD_AUTO); }
-  void SetCpuSimdToOn() { this->SetCpuSimd(CPU_SIMD_ON); }
-  void SetCpuSimdToOff() { this->SetCpuSimd(CPU_SIMD_OFF); }
-  ///@}
-
   enum Accelerators
   {
     OCTREE = 0,
@@ -195,13 +173,12 @@ public:
   /**
    * Where the first numbers of each pixel sample come from: SOBOL (default;
    * Owen-scrambled Sobol' pairs for the pixel position and the first two
-   * scattering events, which reach a given error 1.1-1.26 times sooner) or
-   * INDEPENDENT (every number from the sample's random stream). Both are
-   * unbiased, and GetRelativeNoise() is the error of either: it compares a
-   * pixel's even samples with its odd ones, two independently scrambled
-   * nets. (A pixel's own sample variance, which the z-score tests of the
-   * mapper use, overstates a SOBOL image's error by 13-20 %: those tests
-   * use INDEPENDENT.)
+   * scattering events, which reach a given error sooner) or INDEPENDENT
+   * (every number from the sample's random stream). Both are unbiased, and
+   * GetRelativeNoise() is the error of either: it compares a pixel's even
+   * samples with its odd ones, two independently scrambled nets. (A pixel's
+   * own sample variance overstates a SOBOL image's error, so the mapper's
+   * z-score tests use INDEPENDENT.)
    */
   vtkSetClampMacro(Sampler, int, SOBOL, INDEPENDENT);
   vtkGetMacro(Sampler, int);
@@ -629,8 +606,8 @@ public:
   static double GetLabelDensityAtFullOpacity();
 
   /**
-   * Description of the backend in use ("cpu, 2 thread(s), SIMD AVX3", "cpu, 2
-   * thread(s), scalar", "cuda, ..."): after a render, what rendered its scene.
+   * Description of the backend in use ("cpu, 2 thread(s)", "cuda, ..."):
+   * after a render, what rendered its scene.
    */
   const char* GetBackendDescription();
 
@@ -646,7 +623,6 @@ protected:
   int Seed = 0;
   int NumberOfThreads = 0;
   int Backend = AUTO;
-  int CpuSimd = CPU_SIMD_AUTO;
   double Exposure = 1.0;
   int ToneMapping = AUTOMATIC_TONE_MAPPING;
   vtkTypeBool UnshadedScattering = 0;
@@ -709,7 +685,7 @@ private:
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
   // Sets a setting that leaves the converged image as it is (what DrawFilm
-  // reads, how far and how refinement goes, the CPU's threads and SIMD) to
+  // reads, how far and how refinement goes, the CPU's threads) to
   // `value`: the accumulation goes on (GetTracingMTime). False when it
   // already had that value.
   template <class T>

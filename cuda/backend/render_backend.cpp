@@ -15,9 +15,8 @@ namespace {
 
 class CpuBackend : public Renderer {
  public:
-  CpuBackend(int threads, SimdMode simd) : cpu_(threads, simd) {}
+  explicit CpuBackend(int threads) : cpu_(threads) {}
   std::string Description() const override { return cpu_.Description(); }
-  std::string Description(const SceneView& view) const override { return cpu_.Description(&view); }
   bool IsCuda() const override { return false; }
   bool Render(const Scene&, const SceneView& view, Film& film, int spp, TraceCounters* counters,
               const Progress& progress, const std::atomic<bool>* cancel) override {
@@ -37,8 +36,8 @@ class CudaBackend : public Renderer {
  public:
   // With `fallbackThreads` >= 0 (auto), a scene too large for the device is
   // rendered on the CPU instead, with a note; otherwise the error stands.
-  CudaBackend(int fallbackThreads, SimdMode fallbackSimd, std::function<void(const std::string&)> note)
-      : fallbackThreads_(fallbackThreads), fallbackSimd_(fallbackSimd), note_(std::move(note)) {}
+  CudaBackend(int fallbackThreads, std::function<void(const std::string&)> note)
+      : fallbackThreads_(fallbackThreads), note_(std::move(note)) {}
   std::string Description() const override {
     if (fallback_) return fallback_->Description() + " (fallen back from cuda)";
     return "cuda, " + CudaDevice().name;
@@ -86,7 +85,7 @@ class CudaBackend : public Renderer {
       uploads_.Forget();
       if (fallbackThreads_ < 0) throw;
       if (note_) note_(std::string(e.what()) + "; rendering on the CPU instead");
-      fallback_ = std::make_unique<CpuBackend>(fallbackThreads_, fallbackSimd_);
+      fallback_ = std::make_unique<CpuBackend>(fallbackThreads_);
       return onCpu(*fallback_);
     } catch (...) {
       uploads_.Forget();
@@ -96,7 +95,6 @@ class CudaBackend : public Renderer {
 
   GpuRenderer gpu_;
   int fallbackThreads_;
-  SimdMode fallbackSimd_;
   std::function<void(const std::string&)> note_;
   std::unique_ptr<CpuBackend> fallback_;
   SceneUploadPlanner uploads_;
@@ -124,18 +122,18 @@ void RequireBackend(Backend backend) {
 }
 
 std::unique_ptr<Renderer> MakeRenderer(Backend backend, int threads,
-                                       const std::function<void(const std::string&)>& note, SimdMode simd) {
-  if (backend == Backend::Cpu) return std::make_unique<CpuBackend>(threads, simd);
+                                       const std::function<void(const std::string&)>& note) {
+  if (backend == Backend::Cpu) return std::make_unique<CpuBackend>(threads);
 #if MMRTM_HAVE_CUDA
   const CudaDeviceStatus& device = CudaDevice();
-  if (device.available) return std::make_unique<CudaBackend>(backend == Backend::Auto ? threads : -1, simd, note);
+  if (device.available) return std::make_unique<CudaBackend>(backend == Backend::Auto ? threads : -1, note);
   RequireBackend(backend);
   static std::atomic<bool> reported{false};
   if (note && !reported.exchange(true)) note(device.reason + "; rendering on the CPU");
 #else
   RequireBackend(backend);
 #endif
-  return std::make_unique<CpuBackend>(threads, simd);
+  return std::make_unique<CpuBackend>(threads);
 }
 
 }  // namespace mmrtm

@@ -40,14 +40,8 @@ void RequireBackend(Backend backend);
 class Renderer {
  public:
   virtual ~Renderer() = default;
-  // "cpu, 2 thread(s), SIMD AVX3", "cuda, NVIDIA H100 ...": for progress
-  // lines and stats; the second says what renders `view` (the CPU's SIMD
-  // lanes run some scenes only).
+  // "cpu, 2 thread(s)", "cuda, NVIDIA H100 ...": for progress lines and stats.
   virtual std::string Description() const = 0;
-  virtual std::string Description(const SceneView& view) const {
-    (void)view;
-    return Description();
-  }
   virtual bool IsCuda() const = 0;
   // Adds `samplesPerPixel` samples of `view` (built by `scene`, whose grid
   // the CUDA backend refits on the device) to `film`. Returns false when
@@ -67,9 +61,8 @@ class Renderer {
 
 // `note` receives one-line remarks for the user (why auto chose the CPU, a
 // fall-back after a GPU allocation failed). Throws BackendError for an
-// explicit `cuda` that cannot run. `simd`: the CPU's (cpu_renderer.h).
+// explicit `cuda` that cannot run.
 std::unique_ptr<Renderer> MakeRenderer(Backend backend, int threads,
-                                       const std::function<void(const std::string&)>& note = nullptr,
-                                       SimdMode simd = SimdMode::Auto);
+                                       const std::function<void(const std::string&)>& note = nullptr);
 
 }  // namespace mmrtm

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdlib>
-#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -12,42 +10,13 @@
 
 #include "mmrtm/integrator.h"
 #include "cpu_projection.h"
-#include "wavefront_tile.h"
 
 namespace mmrtm {
 
-std::optional<SimdMode> ParseSimdMode(const std::string& name) {
-  if (name == "off") return SimdMode::Off;
-  if (name == "auto") return SimdMode::Auto;
-  if (name == "on") return SimdMode::On;
-  return std::nullopt;
-}
+CpuRenderer::CpuRenderer(int threads)
+    : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())) {}
 
-CpuRenderer::CpuRenderer(int threads, SimdMode simd)
-    : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())), simd_(simd) {
-  // A test harness runs everything on one tracker (the planted-defect
-  // check runs its checks on both): MMRTM_CPU_SIMD=on|off decides auto.
-  const char* forced = std::getenv("MMRTM_CPU_SIMD");
-  if (simd_ == SimdMode::Auto && forced && *forced) {
-    const std::optional<SimdMode> mode = ParseSimdMode(forced);
-    if (!mode) throw std::invalid_argument(std::string("MMRTM_CPU_SIMD=") + forced + ": expected auto, on or off");
-    simd_ = *mode;
-  }
-}
-
-bool CpuRenderer::UsesSimd(const SceneView& scene) const {
-  if (simd_ == SimdMode::Off || scene.settings.projection.mode != IntensityProjection::None) return false;
-  return simd_ == SimdMode::On ? WavefrontCameraPaths::Runs(scene) : WavefrontCameraPaths::Faster(scene);
-}
-
-std::string CpuRenderer::Description(const SceneView* scene) const {
-  const std::string d = "cpu, " + std::to_string(threads_) + " thread(s), ";
-  const std::string lanes = std::string("SIMD ") + SimdLookupTarget();
-  if (scene) return d + (UsesSimd(*scene) ? lanes : "scalar");
-  if (!SimdLookupsBuilt() || simd_ == SimdMode::Off) return d + "scalar";
-  if (simd_ == SimdMode::On) return d + lanes;
-  return d + (SimdLookupLanes() >= WavefrontCameraPaths::kFasterLanes ? lanes + " where faster" : "scalar");
-}
+std::string CpuRenderer::Description() const { return "cpu, " + std::to_string(threads_) + " thread(s)"; }
 
 bool CpuRenderer::Render(const SceneView& scene, Film& film, int samplesPerPixel, TraceCounters* counters,
                          const Progress& progress, const std::atomic<bool>* cancel) const {
@@ -90,39 +59,32 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   std::mutex progressMutex;
   int tilesDone = 0;
   std::vector<TraceCounters> perThread(threads_);
-  std::vector<LaneCounters> lanesPerThread(threads_);
 
   const bool projecting = s.settings.projection.mode != IntensityProjection::None;  // mmrtm/projection.h
-  const bool wavefront = UsesSimd(s);
   auto worker = [&](int thread) {
     TraceCounters& ctr = perThread[thread];
-    const std::unique_ptr<WavefrontTile> wavefrontTile = wavefront ? std::make_unique<WavefrontTile>() : nullptr;
     for (int tile; (tile = nextTile.fetch_add(1)) < tileCount;) {
       if (cancel && cancel->load(std::memory_order_relaxed)) break;
       const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
       const int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
-      if (wavefront) {
-        wavefrontTile->Render(s, film, view, x0, y0, x1, y1, end, ctr, &lanesPerThread[thread]);
-      } else {
-        for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) {
-            const uint32_t first = film.PixelSamples(x, y), last = end((size_t)y * width + x, first);
-            if (projecting) {
-              for (uint32_t index = first; index < last; ++index) {
-                const PixelSample ps = ProjectPixelOnCpu(s, x, y, ctr);
-                view.AddSample(x, y, ps.L, ps.alpha, index + 1);
-              }
-              continue;
-            }
-            const uint64_t workBefore = ctr.Work();
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const uint32_t first = film.PixelSamples(x, y), last = end((size_t)y * width + x, first);
+          if (projecting) {
             for (uint32_t index = first; index < last; ++index) {
-              PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
+              const PixelSample ps = ProjectPixelOnCpu(s, x, y, ctr);
               view.AddSample(x, y, ps.L, ps.alpha, index + 1);
-              view.AddDenoiserInputs(x, y, ps.L, ps.albedo, ps.normal, index + 1);
             }
-            view.AddWork(x, y, (float)(ctr.Work() - workBefore));
+            continue;
           }
-      }
+          const uint64_t workBefore = ctr.Work();
+          for (uint32_t index = first; index < last; ++index) {
+            PixelSample ps = RenderPixelSample(s, x, y, index, ctr);
+            view.AddSample(x, y, ps.L, ps.alpha, index + 1);
+            view.AddDenoiserInputs(x, y, ps.L, ps.albedo, ps.normal, index + 1);
+          }
+          view.AddWork(x, y, (float)(ctr.Work() - workBefore));
+        }
       if (progress) {
         std::lock_guard<std::mutex> lock(progressMutex);
         progress(++tilesDone, tileCount);
@@ -138,8 +100,6 @@ bool CpuRenderer::RenderRanges(const SceneView& scene, Film& film, const std::fu
   if (cancel && cancel->load()) return false;
   if (counters)
     for (const TraceCounters& c : perThread) *counters += c;
-  if (lanes_)
-    for (const LaneCounters& l : lanesPerThread) *lanes_ += l;
   return true;
 }
 

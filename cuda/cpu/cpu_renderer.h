@@ -6,41 +6,22 @@
 
 #include <atomic>
 #include <functional>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "film.h"
 #include "mmrtm/counters.h"
 #include "mmrtm/scene_view.h"
-#include "wavefront_camera_paths.h"
 
 namespace mmrtm {
 
-// --simd auto|on|off. On: the SIMD backend where it runs (a build with
-// Highway, delta tracking over a majorant grid, no intensity projection:
-// WavefrontCameraPaths::Runs): a tile's camera rays delta-tracked in SIMD
-// lanes (wavefront_camera_paths.h). Off: the scalar backend. Both give the
-// same image to the last bit. Auto: the faster of the two for the scene
-// on this CPU (WavefrontCameraPaths::Faster: the SIMD backend where the
-// lanes start the camera paths too and have 8 or more floats, AVX2 and
-// AVX-512; Documentation/performance.md, "SIMD lanes: the camera stage").
-enum class SimdMode { Off, Auto, On };
-std::optional<SimdMode> ParseSimdMode(const std::string& name);
-
 class CpuRenderer {
  public:
-  // threads <= 0: one per hardware thread. `simd` Auto takes the
-  // environment's MMRTM_CPU_SIMD (on, off) where it is set.
-  explicit CpuRenderer(int threads = 0, SimdMode simd = SimdMode::Auto);
+  // threads <= 0: one per hardware thread.
+  explicit CpuRenderer(int threads = 0);
   int Threads() const { return threads_; }
-  // Whether a render of `scene` runs the SIMD backend.
-  bool UsesSimd(const SceneView& scene) const;
-  // "cpu, 2 thread(s), SIMD AVX3" (or "scalar"): what renders `scene`; without
-  // one, what this mode runs where it can ("SIMD AVX3 where faster" for auto).
-  std::string Description(const SceneView* scene = nullptr) const;
-  // Where the renders that follow add their lanes' occupancy (null: not counted).
-  void CountLanes(LaneCounters* lanes) { lanes_ = lanes; }
+  // "cpu, 2 thread(s)": for progress lines and stats.
+  std::string Description() const;
 
   // Called with (tiles done, tiles total) as tiles finish, from one thread at a time.
   using Progress = std::function<void(int, int)>;
@@ -68,8 +49,6 @@ class CpuRenderer {
   bool RenderRanges(const SceneView& scene, Film& film, const std::function<uint32_t(size_t, uint32_t)>& end,
                     TraceCounters* counters, const Progress& progress, const std::atomic<bool>* cancel) const;
   int threads_;
-  SimdMode simd_;
-  LaneCounters* lanes_ = nullptr;
 };
 
 }  // namespace mmrtm

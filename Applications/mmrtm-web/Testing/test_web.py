@@ -395,8 +395,8 @@ class WebViewerTest(unittest.TestCase):
 
     def test_c_slicers_cpu_ray_cast_covers_the_same_pixels_and_switching_back_converges_again(self):
         """The method menu switches the same volume and preset to Slicer's
-        CPU ray cast: its silhouette overlaps ours by at least 0.85 (the
-        probe of issue 33 measured 0.932); switching back path traces
+        CPU ray cast: its silhouette overlaps ours by at least 0.85 (a probe
+        measured 0.932); switching back path traces
         again, to the same silhouette. Catches a 3D view that is not the
         volume (a wrong camera, grid or geometry in our pipeline) and a
         switch back that leaves the new display node without our settings."""

@@ -11,7 +11,6 @@
 
 #include "mmrtm/defs.h"
 #include "mmrtm/material.h"
-#include "mmrtm/scalar_lanes.h"
 #include "mmrtm/transfer_function.h"
 #include "mmrtm/volume.h"
 
@@ -126,17 +125,15 @@ struct Classifier {
   }
 
   // A plain scene's one density TF, and the extinction where it gives
-  // `density` (per lane: the SIMD lookup in cuda/simd runs this too).
+  // `density`.
   MMRTM_CPU_GPU const TransferFunctionView& PlainDensityTF() const {
     return tfs[bindings[materials[0].bindingBegin].tf];
   }
-  template <class L>
-  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float PlainExtinction(typename L::Float density) const {
-    return L::Min(L::Splat(materials[0].base[0]) * density, L::Splat(maxExtinction));
+  MMRTM_INLINE MMRTM_CPU_GPU float PlainExtinction(float density) const {
+    return Min(materials[0].base[0] * density, maxExtinction);
   }
   // Makes *c a plain scene's classification where the volume's value is
-  // `value` and the extinction sigma_t (the SIMD lanes compute both and
-  // classify here too).
+  // `value` and the extinction sigma_t.
   MMRTM_CPU_GPU static void SetPlainClassification(float value, float sigma_t, Classification* c) {
     c->proxies.v[0] = value;
     c->sigma_t = sigma_t;
@@ -162,7 +159,7 @@ struct Classifier {
       c.proxies.v[0] = proxies[0].SampleIndex(index0);
       float v;
       PlainDensityTF().Evaluate(c.proxies.v[0], &v);
-      SetPlainClassification(c.proxies.v[0], PlainExtinction<ScalarLanes>(v), &c);
+      SetPlainClassification(c.proxies.v[0], PlainExtinction(v), &c);
       return c;
     }
     if (cropKeep != kNoCropping && Cropped(world)) return c;  // (a cropped scene is not plain)

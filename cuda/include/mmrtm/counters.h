@@ -32,25 +32,4 @@ struct TraceCounters {
   }
 };
 
-// How full the SIMD lanes of the CPU's backend were (cuda/simd/
-// grid_walk_lanes.h): the walk's actions (each with `lanes` lanes) and the
-// live lanes summed over them, the lanes' refills, the lookup rounds
-// (actions with arrivals) and the arrivals looked up in them.
-struct LaneCounters {
-  uint64_t lanes = 0, actions = 0, liveLanes = 0, refills = 0, lookupRounds = 0, lookups = 0;
-
-  LaneCounters& operator+=(const LaneCounters& o) {
-    lanes = o.lanes ? o.lanes : lanes;
-    actions += o.actions;
-    liveLanes += o.liveLanes;
-    refills += o.refills;
-    lookupRounds += o.lookupRounds;
-    lookups += o.lookups;
-    return *this;
-  }
-  // The fraction of the lanes that had work, in the walk and in the lookups.
-  double WalkOccupancy() const { return actions ? (double)liveLanes / ((double)actions * lanes) : 0.0; }
-  double LookupOccupancy() const { return lookupRounds ? (double)lookups / ((double)lookupRounds * lanes) : 0.0; }
-};
-
 }  // namespace mmrtm

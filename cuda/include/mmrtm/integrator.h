@@ -59,12 +59,8 @@ MMRTM_CPU_GPU inline bool ChooseAndReuse(float p, float* u) {
 // application in front, e.g. a VTK mesh); beyond it the pixel is not the
 // volume's and nothing (not even the environment) is seen.
 // `pairs`, when given, supplies the first vertices' numbers.
-// `cameraFreePath`, when given, is the camera ray's free path, sampled
-// already with `rng` (the CPU's SIMD backend tracks many camera rays at
-// once: cpu/wavefront_camera_paths.h); rng is then where that left it.
 MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, TraceCounters& ctr,
-                                    float cameraTMax = kInfinity, const SobolPairs* pairs = nullptr,
-                                    const FreePathResult* cameraFreePath = nullptr) {
+                                    float cameraTMax = kInfinity, const SobolPairs* pairs = nullptr) {
   PixelSample out;
   RGB beta(1.f);
   float scatterPdf = 0.f;  // pdf of the last sampled direction, for MIS
@@ -81,14 +77,10 @@ MMRTM_CPU_GPU inline PixelSample Li(const SceneView& s, Ray ray, PCG32& rng, Tra
     // This vertex's low-discrepancy pairs, or none (then rng).
     const SobolPairs* ld = depth < kSobolVertices ? pairs : nullptr;
     const int pairBase = kPairFirstVertex + depth * kPairsPerVertex;
-    FreePathResult fp;
-    if (depth == 0 && cameraFreePath) {
-      fp = *cameraFreePath;
-    } else {
-      float ldFreePath[2];
-      if (ld) ld->Get(pairBase + kPairFreePath, &ldFreePath[0], &ldFreePath[1]);
-      fp = SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr, ld ? ldFreePath : nullptr);
-    }
+    float ldFreePath[2];
+    if (ld) ld->Get(pairBase + kPairFreePath, &ldFreePath[0], &ldFreePath[1]);
+    FreePathResult fp =
+        SampleFreePath(s, ray, depth == 0 ? cameraTMax : kInfinity, rng, ctr, ld ? ldFreePath : nullptr);
     if (!fp.collided) {
       if (depth == 0 && cameraTMax < kInfinity) break;  // stopped at opaque geometry
       if (s.environmentLight >= 0) {
@@ -273,18 +265,7 @@ struct CameraSample {
     ray = s.camera.GenerateRay((float)x + fx, (float)y + fy, l0, l1);
     tMax = s.cameraRayMaxDistance ? s.cameraRayMaxDistance[x + (int64_t)s.camera.width * y] : kInfinity;
   }
-  // A sample whose numbers, ray and end were made elsewhere (the CPU's SIMD
-  // lanes make them with CameraSample's operations:
-  // cuda/simd/camera_path_starts.h).
-  MMRTM_CPU_GPU CameraSample(PCG32 rng_, SobolPairs pairs_, bool sobol_, Ray ray_, float tMax_)
-      : rng(rng_), pairs(pairs_), sobol(sobol_), ray(ray_), tMax(tMax_) {}
   MMRTM_CPU_GPU const SobolPairs* Pairs() const { return sobol ? &pairs : nullptr; }
-  // The camera vertex's pair of the free path (its first arrival and its
-  // real-or-null choice), or negatives (drawn from rng).
-  MMRTM_CPU_GPU void FreePathPair(float* u0, float* u1) const {
-    *u0 = *u1 = -1.f;
-    if (sobol) pairs.Get(kPairFirstVertex + kPairFreePath, u0, u1);
-  }
 };
 
 // One sample of pixel (x, y).

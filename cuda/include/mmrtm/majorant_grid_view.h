@@ -75,17 +75,6 @@ MMRTM_CPU_GPU inline uint8_t EncodeMinorant(float majorant, float minorant) {
   return (uint8_t)q;
 }
 
-// The state of a walk over the grid (GridMajorantIterator's, less what
-// follows from the ray and the level), for the SIMD walk that continues
-// many of them in lanes (cuda/simd/grid_walk_lanes.h).
-struct GridWalkState {
-  Vec3 o, d;  // the ray in index space
-  float invD[3], tFace[3];
-  float t, tEnd;
-  int level, cell[3];
-  int64_t node;
-};
-
 // Walks the grid along a ray given in voxel index space (its parameter t is
 // the world distance), handing out majorant segments.
 class GridMajorantIterator {
@@ -114,22 +103,6 @@ class GridMajorantIterator {
       cell_[a] = FloorClamped(x, grid->res[level_][a] - 1);
     }
     EnterLevel();
-  }
-
-  MMRTM_CPU_GPU GridWalkState State() const {
-    GridWalkState s;
-    s.o = o_;
-    s.d = d_;
-    for (int a = 0; a < 3; ++a) {
-      s.invD[a] = invD_[a];
-      s.tFace[a] = tFace_[a];
-      s.cell[a] = cell_[a];
-    }
-    s.t = t_;
-    s.tEnd = tEnd_;
-    s.level = level_;
-    s.node = node_;
-    return s;
   }
 
   // The next segment with a non-zero majorant, and a lower bound of the

@@ -35,7 +35,6 @@ enum class Defect : uint8_t {
   MapperColorRefit,   // the VTK mapper does not refit after a colour-function edit
   LabelSwap,          // label materials 1 and 2 swapped
   FilmVariance,       // the film's variance of the mean halved
-  SimdExtinction,     // the SIMD lanes' extinction x0.98 (the scalar lookups untouched)
   DenoiseVariance,    // Auto's estimate subtracts Var A + Var B (the halves' whole difference), not Var B
   // The VTK property's translation (VTKModule/Rendering/mmrtmVtkSceneTranslation.cxx), each rule 1 % off:
   VtkExtinction,         // sigma_t from scalar opacity per unit distance x1.01
@@ -67,7 +66,6 @@ inline const char* DefectName(Defect d) {
                                       "mapper_color_refit",
                                       "label_swap",
                                       "film_variance",
-                                      "simd_extinction",
                                       "denoise_variance",
                                       "vtk_extinction",
                                       "vtk_color",

@@ -9,8 +9,7 @@
 
 namespace mmrtm {
 
-// The constants of the hashes and the generator below, named for the SIMD
-// lanes that compute the same numbers (cuda/simd/camera_path_starts.cpp).
+// The constants of the hashes and the generator below.
 constexpr uint64_t kMixBitsMultiplier0 = 0x7fb5d329728ea185ULL, kMixBitsMultiplier1 = 0x81dadef4bc2dd44dULL;
 constexpr uint64_t kPCG32Multiplier = 0x5851f42d4c957f2dULL;
 constexpr uint64_t kPixelSequenceSalt = 0x9e3779b97f4a7c15ULL, kSampleOffsetMultiplier = 0x2545f4914f6cdd1dULL;
@@ -36,15 +35,6 @@ class PCG32 {
  public:
   MMRTM_CPU_GPU PCG32() { SetSequence(0, 0x853c49e6748fea9bULL); }
   MMRTM_CPU_GPU PCG32(uint64_t sequence, uint64_t offset) { SetSequence(sequence, offset); }
-  // The generator whose state and increment are these (State(), Inc()).
-  MMRTM_CPU_GPU static PCG32 FromState(uint64_t state, uint64_t inc) {
-    PCG32 g(Uninitialised{});
-    g.state_ = state;
-    g.inc_ = inc;
-    return g;
-  }
-  MMRTM_CPU_GPU uint64_t State() const { return state_; }
-  MMRTM_CPU_GPU uint64_t Inc() const { return inc_; }
 
   // Selects stream `sequence`, starting at a state derived from `offset`.
   MMRTM_CPU_GPU void SetSequence(uint64_t sequence, uint64_t offset) {
@@ -67,8 +57,6 @@ class PCG32 {
   MMRTM_CPU_GPU float Uniform() { return UniformFloat(NextU32()); }
 
  private:
-  struct Uninitialised {};
-  MMRTM_CPU_GPU explicit PCG32(Uninitialised) {}
   uint64_t state_, inc_;
 };
 

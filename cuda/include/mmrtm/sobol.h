@@ -64,8 +64,7 @@ MMRTM_CPU_GPU inline uint32_t SobolDimension1Reversed(uint32_t index) {
   return index;
 }
 
-// The constants of the scramble and of the pairs' hashes below, named for
-// the SIMD lanes that compute the same numbers, as rng.h's.
+// The constants of the scramble and of the pairs' hashes below.
 constexpr uint32_t kOwenMultiplier0 = 0x3d20adeau, kOwenMultiplier1 = 0x05526c56u, kOwenMultiplier2 = 0x53a22864u;
 constexpr uint64_t kSobolKeySalt = 0x5851f42d4c957f2dULL, kSobolReplicateMultiplier = 0xda942042e4dd58b5ULL;
 constexpr uint64_t kSobolPairMultiplier = 0x9e3779b97f4a7c15ULL;

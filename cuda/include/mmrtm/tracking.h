@@ -47,35 +47,8 @@ MMRTM_CPU_GPU inline Classification LookupAndCount(const SceneView& s, Vec3 p, V
   return c;
 }
 
-// The start of a walk over a ray's tentative collisions up to tMax (the
-// arrivals of a Poisson process whose rate is each majorant segment's
-// sigma_maj; `scale` multiplies the extinction and the majorants): the
-// ray's interval in the domain, the majorant walk built in place (a copy
-// of the grid walk's state costs about 55 instructions: mmrtm/majorant.h)
-// and the optical depth to the first arrival: SampleTentativeCollisions'
-// first steps (which it takes in locals), as a struct for the CPU's SIMD
-// lanes where they do not start the paths themselves
-// (cuda/cpu/wavefront_camera_paths.cpp) and for the tests that hold the
-// lanes' own start to it.
-struct TentativeCollisionStart {
-  Ray indexRay;
-  float t0, t1;
-  bool inDomain;
-  MajorantIterator it;
-  float tau = 0.f;  // optical depth to the next arrival
-
-  MMRTM_CPU_GPU TentativeCollisionStart(const SceneView& s, const Ray& ray, float tMax, float scale)
-      : inDomain(s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)),
-        it(inDomain ? s.majorants.Begin(indexRay, t0, t1, scale) : MajorantIterator()) {}
-
-  // Draws the optical depth to the first arrival (a ray in the domain):
-  // `uFirst` when in [0, 1) (a low-discrepancy number), otherwise from rng.
-  MMRTM_CPU_GPU void DrawFirstArrival(PCG32& rng, float uFirst) {
-    tau = OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
-  }
-  // The optical depth to an arrival, Exp(1), from a uniform u.
-  MMRTM_CPU_GPU static float OpticalDepthToArrival(float u) { return -logf(1.f - u); }
-};
+// The optical depth to an arrival, Exp(1), from a uniform u.
+MMRTM_CPU_GPU inline float OpticalDepthToArrival(float u) { return -logf(1.f - u); }
 
 // Walks the tentative collisions of a ray up to tMax and calls visit(t,
 // classification, sigma_maj) at each until visit returns false or the ray
@@ -87,27 +60,23 @@ struct TentativeCollisionStart {
 // also allows). The same distribution; but a segment without a collision
 // costs a multiply and a compare instead of a random number and a logf, and
 // an octree walk hands out about two segments per lookup.
-// `uFirst` as in TentativeCollisionStart::DrawFirstArrival.
+// `uFirst`: the uniform of the first arrival when in [0, 1) (a
+// low-discrepancy number), otherwise drawn from rng.
 //
 // segment(seg) is called first for every segment; false ends the walk.
 // With `Residual` the arrivals' rate is sigma_maj - sigma_min instead (the
 // residual of residual ratio tracking, which takes the control part,
 // exp(-sigma_min * length), in segment), and visit gets (classification,
 // residual segment), whose sigma_maj is that rate.
-// The SIMD lanes' walk (cuda/simd/grid_walk_lanes.cpp) mirrors this loop
-// for delta tracking; Testing/Cxx/TestSimdBackend holds the two to the
-// same bits.
 template <bool Residual = false, typename Visit, typename Segment>
 MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ray& ray, float tMax, float scale,
                                                     PCG32& rng, TraceCounters& ctr, Visit visit, Segment segment,
                                                     float uFirst = -1.f) {
-  // TentativeCollisionStart's steps in locals, which stay in registers
-  // (through the struct, RatioTrack ran 2 % more instructions).
   Ray indexRay;
   float t0, t1;
   if (!s.DomainInterval(ray, tMax, &indexRay, &t0, &t1)) return;
   MajorantIterator it = s.majorants.Begin(indexRay, t0, t1, scale);
-  float tau = TentativeCollisionStart::OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
+  float tau = OpticalDepthToArrival(uFirst >= 0.f ? uFirst : rng.Uniform());
   RayMajorantSegment seg;
   while (it.Next(&seg)) {
     ++ctr.majorantSegments;
@@ -133,7 +102,7 @@ MMRTM_CPU_GPU inline void SampleTentativeCollisions(const SceneView& s, const Ra
       } else {
         if (!visit(t, c, seg.sigma_maj)) return;
       }
-      tau = TentativeCollisionStart::OpticalDepthToArrival(rng.Uniform());
+      tau = OpticalDepthToArrival(rng.Uniform());
     }
   }
 }

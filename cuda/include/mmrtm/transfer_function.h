@@ -17,7 +17,6 @@
 
 #include "mmrtm/defs.h"
 #include "mmrtm/planted_defect.h"
-#include "mmrtm/scalar_lanes.h"
 
 namespace mmrtm {
 
@@ -84,9 +83,9 @@ struct TransferFunctionView {
     if (type == TFType::CCTF) {
       if (x <= keys[0] || count == 1) return Copy(0, out);
       if (x >= keys[count - 1]) return Copy(count - 1, out);
-      const int lo = CurveSegment<ScalarLanes>(x);
-      const float t = CurveFraction<ScalarLanes>(x, lo);
-      for (int c = 0; c < channels; ++c) out[c] = CurveChannel<ScalarLanes>(t, lo, c);
+      const int lo = CurveSegment(x);
+      const float t = CurveFraction(x, lo);
+      for (int c = 0; c < channels; ++c) out[c] = CurveChannel(t, lo, c);
       return;
     }
     int i = FindEntry(x);
@@ -97,66 +96,46 @@ struct TransferFunctionView {
     }
   }
 
-  // The CCTF's per-lane arithmetic, for any lane type (scalar_lanes.h):
-  // Evaluate runs it on one lane, the SIMD lookup (cuda/simd) on many.
-
   // CCTF: the segment lo with keys[lo] <= x < keys[lo + 1], for x strictly
-  // between the first and the last key. (A lane whose x is outside gets
-  // some lo in [-1, count - 1]; its caller takes an end value instead.)
-  template <class L>
-  MMRTM_INLINE MMRTM_CPU_GPU typename L::Int CurveSegment(typename L::Float x) const {
-    using Float = typename L::Float;
-    using Int = typename L::Int;
-    using Mask = typename L::Mask;
+  // between the first and the last key.
+  MMRTM_INLINE MMRTM_CPU_GPU int CurveSegment(float x) const {
     if (uniformInverseStep > 0.f) {
-      const Float f = (x - L::Splat(keys[0])) * L::Splat(uniformInverseStep);
-      const Mask estimated = L::And(L::GreaterEq(f, L::Splat(0.f)), L::Less(f, L::Splat((float)(count - 1))));
-      if (L::AnyTrue(estimated)) {
+      const float f = (x - keys[0]) * uniformInverseStep;
+      if (f >= 0.f && f < (float)(count - 1)) {
         // Evenly spaced keys (to within a quarter step, Scene::Build
-        // checks): the estimate is the segment or one of its neighbours. A
-        // lane without an estimate reads keys[0] here, in bounds.
-        const Int one = L::SplatInt(1);
-        const Int lo = L::Truncate(L::Select(estimated, f, L::Splat(0.f)));
-        const Mask before = L::Greater(L::Gather(keys, lo), x);
-        const Mask after = L::LessEq(L::Gather(keys, lo + one), x);
-        const Int segment = L::SelectInt(before, lo - one, L::SelectInt(after, lo + one, lo));
-        if (L::AllTrue(estimated)) return segment;
-        return L::SelectInt(estimated, segment, BisectCurve<L>(x));
+        // checks): the estimate is the segment or one of its neighbours.
+        const int lo = (int)f;
+        if (keys[lo] > x) return lo - 1;
+        return keys[lo + 1] <= x ? lo + 1 : lo;
       }
     }
-    return BisectCurve<L>(x);
+    return BisectCurve(x);
   }
 
   // CCTF: the segment by binary search (keys not evenly spaced, or x beyond
-  // the estimate's range). Lanes whose search has closed keep reading their
-  // own lo, in bounds.
-  template <class L>
-  MMRTM_INLINE MMRTM_CPU_GPU typename L::Int BisectCurve(typename L::Float x) const {
-    using Int = typename L::Int;
-    using Mask = typename L::Mask;
-    Int lo = L::SplatInt(0), hi = L::SplatInt(count - 1);  // keys[lo] <= x < keys[hi]
-    for (;;) {
-      const Mask open = L::GreaterInt(hi - lo, L::SplatInt(1));
-      if (!L::AnyTrue(open)) return lo;
-      const Int mid = L::Midpoint(lo, hi);
-      const Mask atOrBelow = L::LessEq(L::Gather(keys, mid), x);
-      lo = L::SelectInt(L::And(open, atOrBelow), mid, lo);
-      hi = L::SelectInt(L::And(open, L::Not(atOrBelow)), mid, hi);
+  // the estimate's range).
+  MMRTM_INLINE MMRTM_CPU_GPU int BisectCurve(float x) const {
+    int lo = 0, hi = count - 1;  // keys[lo] <= x < keys[hi]
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) >> 1;
+      if (keys[mid] <= x)
+        lo = mid;
+      else
+        hi = mid;
     }
+    return lo;
   }
 
   // CCTF: x's position in segment lo, 0 at keys[lo] and 1 at keys[lo + 1].
-  template <class L>
-  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float CurveFraction(typename L::Float x, typename L::Int lo) const {
-    const typename L::Float k0 = L::Gather(keys, lo), k1 = L::Gather(keys, lo + L::SplatInt(1));
+  MMRTM_INLINE MMRTM_CPU_GPU float CurveFraction(float x, int lo) const {
+    const float k0 = keys[lo], k1 = keys[lo + 1];
     return (x - k0) / (k1 - k0);
   }
 
   // CCTF: channel c at fraction t of segment lo.
-  template <class L>
-  MMRTM_INLINE MMRTM_CPU_GPU typename L::Float CurveChannel(typename L::Float t, typename L::Int lo, int c) const {
-    const typename L::Int first = lo * L::SplatInt(channels) + L::SplatInt(c);
-    return LerpLanes<L>(t, L::Gather(values, first), L::Gather(values, first + L::SplatInt(channels)));
+  MMRTM_INLINE MMRTM_CPU_GPU float CurveChannel(float t, int lo, int c) const {
+    const int first = lo * channels + c;
+    return Lerp(t, values[first], values[first + channels]);
   }
 
   // Material TFs: the material at x, or kNoMaterial.

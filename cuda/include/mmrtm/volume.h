@@ -8,7 +8,6 @@
 #pragma once
 
 #include "mmrtm/defs.h"
-#include "mmrtm/scalar_lanes.h"
 #include "mmrtm/vecmath.h"
 
 namespace mmrtm {
@@ -20,42 +19,28 @@ MMRTM_CPU_GPU inline int VoxelTypeSize(VoxelType t) {
   return t == VoxelType::UInt8 ? 1 : (t == VoxelType::Float32 ? 4 : 2);
 }
 
-// The per-lane arithmetic of a lookup, for any lane type (scalar_lanes.h):
-// VolumeView runs it on one lane, the SIMD lookup (cuda/simd) on many, so
-// that both compute the same bits.
-
 // One axis of a trilinear lookup at index coordinate p: p clamped to the
 // domain [0, last] as Min(Max()), which compiles to two instructions (and
 // takes NaN to 0); then the cell's first corner, at least 0 and at most
 // lastCell; and p's fraction within that cell.
-template <class L>
-MMRTM_INLINE MMRTM_CPU_GPU void TrilinearAxis(typename L::Float p, float last, int lastCell, typename L::Int* corner,
-                                              typename L::Float* t) {
-  const typename L::Float f = L::Min(L::Max(p, L::Splat(0.f)), L::Splat(last));
-  *corner = L::MinInt(L::Truncate(f), L::SplatInt(lastCell));
-  *t = f - L::ToFloat(*corner);
+MMRTM_INLINE MMRTM_CPU_GPU void TrilinearAxis(float p, float last, int lastCell, int* corner, float* t) {
+  const float f = Min(Max(p, 0.f), last);
+  *corner = MinInt((int)f, lastCell);
+  *t = f - (float)*corner;
 }
 
 // The voxel nearest to index coordinate p on an axis of voxels 0..last:
 // clamped before the truncating conversion (which is the floor on [0,
 // last]), and 0 for NaN.
-template <class L>
-MMRTM_INLINE MMRTM_CPU_GPU typename L::Int NearestAxis(typename L::Float p, float last) {
-  return L::Truncate(L::Min(L::Max(p + L::Splat(0.5f), L::Splat(0.f)), L::Splat(last)));
-}
+MMRTM_INLINE MMRTM_CPU_GPU int NearestAxis(float p, float last) { return (int)Min(Max(p + 0.5f, 0.f), last); }
 
 // Trilinear interpolation in a cell from its corner values cXYZ (X, Y, Z: 0
 // at the first corner, 1 at the far one) at fractions t within it.
-template <class L>
-MMRTM_INLINE MMRTM_CPU_GPU typename L::Float InterpolateCell(typename L::Float c000, typename L::Float c100,
-                                                             typename L::Float c010, typename L::Float c110,
-                                                             typename L::Float c001, typename L::Float c101,
-                                                             typename L::Float c011, typename L::Float c111,
-                                                             typename L::Float tx, typename L::Float ty,
-                                                             typename L::Float tz) {
-  const typename L::Float c00 = LerpLanes<L>(tx, c000, c100), c10 = LerpLanes<L>(tx, c010, c110);
-  const typename L::Float c01 = LerpLanes<L>(tx, c001, c101), c11 = LerpLanes<L>(tx, c011, c111);
-  return LerpLanes<L>(tz, LerpLanes<L>(ty, c00, c10), LerpLanes<L>(ty, c01, c11));
+MMRTM_INLINE MMRTM_CPU_GPU float InterpolateCell(float c000, float c100, float c010, float c110, float c001,
+                                                 float c101, float c011, float c111, float tx, float ty, float tz) {
+  const float c00 = Lerp(tx, c000, c100), c10 = Lerp(tx, c010, c110);
+  const float c01 = Lerp(tx, c001, c101), c11 = Lerp(tx, c011, c111);
+  return Lerp(tz, Lerp(ty, c00, c10), Lerp(ty, c01, c11));
 }
 
 // A view of one proxy volume: pointer plus extents, no ownership.
@@ -111,8 +96,8 @@ struct VolumeView {
   // Value at a continuous index position, clamped to the domain.
   MMRTM_INLINE MMRTM_CPU_GPU float SampleIndex(Vec3 p) const {
     if (interpolation == Interpolation::Nearest)
-      return Voxel(NearestAxis<ScalarLanes>(p.x, last[0]), NearestAxis<ScalarLanes>(p.y, last[1]),
-                   NearestAxis<ScalarLanes>(p.z, last[2]));
+      return Voxel(NearestAxis(p.x, last[0]), NearestAxis(p.y, last[1]),
+                   NearestAxis(p.z, last[2]));
     switch (type) {
       case VoxelType::UInt8:
         return Trilinear(static_cast<const uint8_t*>(data), p);
@@ -180,9 +165,9 @@ struct VolumeView {
   MMRTM_CPU_GPU float Trilinear(const T* v, Vec3 p) const {
     int x0, y0, z0;
     float tx, ty, tz;
-    TrilinearAxis<ScalarLanes>(p.x, last[0], lastCell[0], &x0, &tx);
-    TrilinearAxis<ScalarLanes>(p.y, last[1], lastCell[1], &y0, &ty);
-    TrilinearAxis<ScalarLanes>(p.z, last[2], lastCell[2], &z0, &tz);
+    TrilinearAxis(p.x, last[0], lastCell[0], &x0, &tx);
+    TrilinearAxis(p.y, last[1], lastCell[1], &y0, &ty);
+    TrilinearAxis(p.z, last[2], lastCell[2], &z0, &tz);
     return InCell(v + Offset(x0, y0, z0), tx, ty, tz);
   }
 
@@ -191,7 +176,7 @@ struct VolumeView {
   template <typename T>
   MMRTM_CPU_GPU float InCell(const T* c, float tx, float ty, float tz) const {
     const int64_t dx = cornerStep[0], dy = cornerStep[1], dz = cornerStep[2];
-    return InterpolateCell<ScalarLanes>((float)c[0], (float)c[dx], (float)c[dy], (float)c[dy + dx], (float)c[dz],
+    return InterpolateCell((float)c[0], (float)c[dx], (float)c[dy], (float)c[dy + dx], (float)c[dz],
                                         (float)c[dz + dx], (float)c[dz + dy], (float)c[dz + dy + dx], tx, ty, tz);
   }
 
