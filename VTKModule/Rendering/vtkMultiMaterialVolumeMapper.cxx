@@ -618,8 +618,9 @@ vtkMTimeType vtkMultiMaterialVolumeMapper::GetTracingMTime()
   // keeps the samples (exposure, tone mapping and the denoised display:
   // only the drawing reads them; the samples per render, the maximum
   // samples and the noise target: how far refinement goes; the threads
-  // and the asynchronous refinement: the same film either way) with nothing modified after it leaves the time it had before, so
-  // the accumulation goes on.
+  // and the asynchronous refinement: the same film either way) with
+  // nothing modified after it leaves the time it had before, so the
+  // accumulation goes on.
   const vtkMTimeType t = this->GetMTime();
   return t == this->Internal->KeptEditAfter ? this->Internal->KeptEditBefore : t;
 }
