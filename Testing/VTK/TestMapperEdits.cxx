@@ -518,6 +518,34 @@ std::vector<Case> Cases()
       const double* origin = o.plane->GetOrigin();
       o.plane->SetOrigin(origin[0] + 20, origin[1], origin[2]);
     } });
+  // The mapper compares what it traces by value: the same plane again (a
+  // new object, as Slicer's pipeline makes at each update), a setting
+  // changed and changed back, and a modification that changes nothing
+  // keep the samples.
+  c.push_back({ "clipping-plane-again", Input::Head,
+    [](Objects& o)
+    {
+      HeadFunctions(o);
+      o.mapper->AddClippingPlane(o.plane);
+    },
+    [](Objects& o)
+    {
+      vtkNew<vtkPlane> same;
+      same->SetOrigin(o.plane->GetOrigin());
+      same->SetNormal(o.plane->GetNormal());
+      o.mapper->RemoveAllClippingPlanes();
+      o.mapper->AddClippingPlane(same);
+    },
+    false, Work::Display });
+  c.push_back({ "seed-changed-back", Input::Head, HeadFunctions,
+    [](Objects& o)
+    {
+      o.mapper->SetSeed(kSeed + 1);
+      o.mapper->SetSeed(kSeed);
+    },
+    false, Work::Display });
+  c.push_back({ "modified-only", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->Modified(); }, false,
+    Work::Display });
   c.push_back({ "cropping", Input::Head, HeadFunctions,
     [](Objects& o)
     {

@@ -247,10 +247,9 @@ struct vtkMultiMaterialVolumeMapper::Internals
   bool ShowedDenoised = false;
   std::string DisplayStatus; // GetDisplayStatus's
 
-  // The last edit that keeps the samples (SetKeepingSamples): the
-  // mapper's modification time before it (as GetTracingMTime gave it) and
-  // after.
-  vtkMTimeType KeptEditBefore = 0, KeptEditAfter = 0;
+  // What GetTracingMTime last found (TracingInputs), and when it changed.
+  std::vector<double> TracingInputsSeen;
+  vtkTimeStamp TracingInputsTime;
 
   int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0, GridRefits = 0;
   // After a Scene.Build: what it did to the majorant grid.
@@ -474,6 +473,49 @@ mmrtm::Scene::Cropping CroppingRegions(vtkVolumeMapper* mapper, vtkVolume* vol)
   }
   return cropping;
 }
+
+// Equal to the bit, NaN to NaN: a setting set again to its value is no change.
+bool SameValues(const std::vector<double>& a, const std::vector<double>& b)
+{
+  return a.size() == b.size() &&
+    std::equal(a.begin(), a.end(), b.begin(),
+      [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); });
+}
+
+// What the traced image depends on in the mapper itself, as values
+// (GetTracingMTime compares them): the settings that ReadInputs,
+// UpdateView, Projection, CroppingRegions and UpdateEnvironment read (the
+// scalar array's name is compared where the input is converted), the
+// backend (a CPU and a CUDA film are not mixed), the clipping planes, and
+// the modification times of the objects the mapper holds (`held`: each a
+// tick of VTK's global clock, so another object is another time). Not
+// among them: the drawing's settings and the refinement's, which keep the
+// samples.
+std::vector<double> TracingInputs(vtkMultiMaterialVolumeMapper* m, std::initializer_list<vtkMTimeType> held)
+{
+  std::vector<double> v = { static_cast<double>(m->GetSeed()), static_cast<double>(m->GetBackend()),
+    static_cast<double>(m->GetGlobalIllumination()), m->GetShadowExtinctionScale(),
+    static_cast<double>(m->GetMaximumBounces()), static_cast<double>(m->GetSampler()),
+    static_cast<double>(m->GetAccelerator()), static_cast<double>(m->GetUnshadedScattering()),
+    static_cast<double>(m->GetBlendMode()), static_cast<double>(m->GetAutoAdjustSampleDistances()),
+    m->GetSampleDistance(), m->GetAverageIPScalarRange()[0], m->GetAverageIPScalarRange()[1],
+    m->GetImageSampleDistance(), m->GetMinimumImageSampleDistance(), static_cast<double>(m->GetMaskType()),
+    m->GetEnvironmentIntensity(), static_cast<double>(m->GetScalarMode()),
+    static_cast<double>(m->GetArrayAccessMode()), static_cast<double>(m->GetArrayId()),
+    static_cast<double>(m->GetCropping()), static_cast<double>(m->GetCroppingRegionFlags()) };
+  const double* crop = m->GetCroppingRegionPlanes();
+  v.insert(v.end(), crop, crop + 6);
+  if (vtkPlaneCollection* planes = m->GetClippingPlanes())
+    for (int i = 0; i < planes->GetNumberOfItems(); ++i)
+    {
+      vtkPlane* plane = planes->GetItem(i);
+      v.insert(v.end(), plane->GetOrigin(), plane->GetOrigin() + 3);
+      v.insert(v.end(), plane->GetNormal(), plane->GetNormal() + 3);
+    }
+  for (vtkMTimeType t : held)
+    v.push_back(static_cast<double>(t));
+  return v;
+}
 }
 
 vtkMultiMaterialVolumeMapper::vtkMultiMaterialVolumeMapper()
@@ -540,50 +582,16 @@ void vtkMultiMaterialVolumeMapper::ResetAccumulation()
   ++this->Internal->FilmGeneration;
 }
 
-void vtkMultiMaterialVolumeMapper::SetExposure(double exposure)
-{
-  this->SetKeepingSamples(this->Exposure, std::max(0.0, exposure));
-}
-
-void vtkMultiMaterialVolumeMapper::SetToneMapping(int mode)
-{
-  this->SetKeepingSamples(this->ToneMapping,
-    std::clamp(mode, static_cast<int>(AUTOMATIC_TONE_MAPPING), static_cast<int>(FILMIC_TONE_MAPPING)));
-}
-
 void vtkMultiMaterialVolumeMapper::SetDenoisingMode(int mode)
 {
   mode = std::clamp(mode, static_cast<int>(DENOISING_OFF), static_cast<int>(DENOISING_ALWAYS));
-  if (!this->SetKeepingSamples(this->DenoisingMode, mode))
+  if (mode == this->DenoisingMode)
     return;
+  this->DenoisingMode = mode;
   this->Internal->Display.SetMode(mode == DENOISING_AUTO ? mmrtm::DenoisingMode::Auto
       : mode == DENOISING_ALWAYS                         ? mmrtm::DenoisingMode::Always
                                                          : mmrtm::DenoisingMode::Off);
-}
-
-void vtkMultiMaterialVolumeMapper::SetSamplesPerRender(int samples)
-{
-  this->SetKeepingSamples(this->SamplesPerRender, std::clamp(samples, 1, 65536));
-}
-
-void vtkMultiMaterialVolumeMapper::SetMaximumSamples(int samples)
-{
-  this->SetKeepingSamples(this->MaximumSamples, std::max(samples, 0));
-}
-
-void vtkMultiMaterialVolumeMapper::SetNoiseTarget(double target)
-{
-  this->SetKeepingSamples(this->NoiseTarget, std::clamp(target, 0.0, 1.0));
-}
-
-void vtkMultiMaterialVolumeMapper::SetNumberOfThreads(int threads)
-{
-  this->SetKeepingSamples(this->NumberOfThreads, std::clamp(threads, 0, 1024));
-}
-
-void vtkMultiMaterialVolumeMapper::SetAsynchronousRefinement(vtkTypeBool asynchronous)
-{
-  this->SetKeepingSamples(this->AsynchronousRefinement, asynchronous);
+  this->Modified();
 }
 
 void vtkMultiMaterialVolumeMapper::SetLookToVTK()
@@ -598,31 +606,20 @@ void vtkMultiMaterialVolumeMapper::SetLookToFilmic()
   this->SetUnshadedScattering(1);
 }
 
-template <class T>
-bool vtkMultiMaterialVolumeMapper::SetKeepingSamples(T& setting, T value)
-{
-  if (value == setting)
-    return false;
-  Internals& in = *this->Internal;
-  const vtkMTimeType before = this->GetTracingMTime();
-  setting = value;
-  this->Modified();
-  in.KeptEditBefore = before;
-  in.KeptEditAfter = this->GetMTime();
-  return true;
-}
-
 vtkMTimeType vtkMultiMaterialVolumeMapper::GetTracingMTime()
 {
-  // The mapper's modification time as far as tracing goes: an edit that
-  // keeps the samples (exposure, tone mapping and the denoised display:
-  // only the drawing reads them; the samples per render, the maximum
-  // samples and the noise target: how far refinement goes; the threads
-  // and the asynchronous refinement: the same film either way) with
-  // nothing modified after it leaves the time it had before, so the
-  // accumulation goes on.
-  const vtkMTimeType t = this->GetMTime();
-  return t == this->Internal->KeptEditAfter ? this->Internal->KeptEditBefore : t;
+  Internals& in = *this->Internal;
+  vtkTexture* environment = in.EnvironmentTexture;
+  const std::vector<double> now = TracingInputs(this,
+    { in.Mask ? in.Mask->GetMTime() : 0, in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0,
+      in.LabelMaterialsTime.GetMTime(), environment ? environment->GetMTime() : 0,
+      environment && environment->GetInput() ? environment->GetInput()->GetMTime() : 0 });
+  if (!SameValues(now, in.TracingInputsSeen))
+  {
+    in.TracingInputsSeen = now;
+    in.TracingInputsTime.Modified();
+  }
+  return in.TracingInputsTime.GetMTime();
 }
 
 void vtkMultiMaterialVolumeMapper::SetMaskInput(vtkImageData* mask)

@@ -82,7 +82,7 @@ public:
    * Samples per pixel added by each Render() (default 4). A change keeps
    * the samples accumulated.
    */
-  void SetSamplesPerRender(int samples);
+  vtkSetClampMacro(SamplesPerRender, int, 1, 65536);
   vtkGetMacro(SamplesPerRender, int);
   ///@}
 
@@ -93,7 +93,7 @@ public:
    * accumulated: raised, refinement goes on from them; lowered below them,
    * the image keeps them all.
    */
-  void SetMaximumSamples(int samples);
+  vtkSetClampMacro(MaximumSamples, int, 0, VTK_INT_MAX);
   vtkGetMacro(MaximumSamples, int);
   ///@}
 
@@ -106,7 +106,7 @@ public:
    * MaximumSamples; 0 (the default) has no noise target. A change keeps
    * the samples accumulated.
    */
-  void SetNoiseTarget(double target);
+  vtkSetClampMacro(NoiseTarget, double, 0.0, 1.0);
   vtkGetMacro(NoiseTarget, double);
   ///@}
 
@@ -124,7 +124,7 @@ public:
    * CPU threads, 0 for all (default 0). A change keeps the samples
    * accumulated (the image does not depend on the thread count).
    */
-  void SetNumberOfThreads(int threads);
+  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
   vtkGetMacro(NumberOfThreads, int);
   ///@}
 
@@ -207,7 +207,7 @@ public:
    * count). IsRefining() says whether a pass (or a denoise) is in flight:
    * an application renders again a little later to pick up its samples.
    */
-  void SetAsynchronousRefinement(vtkTypeBool asynchronous);
+  vtkSetMacro(AsynchronousRefinement, vtkTypeBool);
   vtkGetMacro(AsynchronousRefinement, vtkTypeBool);
   vtkBooleanMacro(AsynchronousRefinement, vtkTypeBool);
   bool IsRefining();
@@ -219,7 +219,7 @@ public:
    * change redraws the samples accumulated so far; it does not start the
    * accumulation again.
    */
-  virtual void SetExposure(double exposure);
+  vtkSetClampMacro(Exposure, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(Exposure, double);
   ///@}
 
@@ -243,7 +243,7 @@ public:
     TONE_MAPPING_OFF = 1,
     FILMIC_TONE_MAPPING = 2
   };
-  virtual void SetToneMapping(int mode);
+  vtkSetClampMacro(ToneMapping, int, AUTOMATIC_TONE_MAPPING, FILMIC_TONE_MAPPING);
   vtkGetMacro(ToneMapping, int);
   void SetToneMappingToAutomatic() { this->SetToneMapping(AUTOMATIC_TONE_MAPPING); }
   void SetToneMappingToOff() { this->SetToneMapping(TONE_MAPPING_OFF); }
@@ -558,10 +558,17 @@ public:
   ///@}
 
   /**
-   * The mapper's modification time as far as the traced image goes: a
-   * change of a setting that keeps the samples (the exposure, the maximum
-   * samples, ...) leaves it as it was. A front end that renders a preview
-   * for a change asks it whether the mapper changed.
+   * When what the mapper traces last changed, compared by value: its
+   * settings that the traced image depends on (seed, bounces, sampler,
+   * accelerator, backend, blend mode, sample distances, cropping, clipping
+   * planes, environment intensity) and the times of what it holds (mask,
+   * multi-material property, label materials, environment texture). A
+   * setting that keeps the samples (exposure, tone mapping, denoising,
+   * samples per render, maximum samples, noise target, threads,
+   * asynchronous refinement) does not change it, nor does a setting set
+   * again to its value. Each render restarts when it changed (or the view
+   * did); a front end that renders a preview for a change asks it whether
+   * the mapper changed.
    */
   vtkMTimeType GetTracingMTime();
 
@@ -684,12 +691,6 @@ private:
   bool InputWillExecute();
   const mmrtm::Film* ImageFilm();
   void UpdateEnvironment();
-  // Sets a setting that leaves the converged image as it is (what DrawFilm
-  // reads, how far and how refinement goes, the CPU's threads) to
-  // `value`: the accumulation goes on (GetTracingMTime). False when it
-  // already had that value.
-  template <class T>
-  bool SetKeepingSamples(T& setting, T value);
   void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
     int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;

@@ -125,9 +125,12 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
 
     def scene(self):
         """What restarts the refinement when it changes: the view's size,
-        each camera, and each of our volumes with its property, mapper and
-        input (their modification times; the mapper's as far as tracing
-        goes, which a raised maximum leaves as it was). A request with the
+        each camera, and each of our volumes: its matrix by value (the
+        Slicer pipeline sets it again at every update, as it does the
+        mapper's clipping planes, and leaves the comparison to the mapper),
+        its visibility, and the modification times of its property and
+        input and the mapper's as far as tracing goes (compared by value in
+        the mapper: a raised maximum leaves it as it was). A request with the
         scene as it was (a browser that connects and sends the view's size
         as it is, a setting that keeps the samples) is answered with the
         frame as it is, without a preview: a preview would stop the pass in
@@ -144,7 +147,10 @@ class ProgressiveRenderScheduler(RcaImageRenderScheduler):
         for volume in path_traced_volumes(self.render_window):
             mapper = volume.GetMapper()
             data = mapper.GetInput()
-            volumes.append((volume.GetMTime(), mapper.GetTracingMTime(), data.GetMTime() if data else 0))
+            matrix = volume.GetMatrix()
+            volumes.append((tuple(matrix.GetElement(i, j) for i in range(4) for j in range(4)), volume.GetVisibility(),
+                            volume.GetProperty().GetMTime() if volume.GetProperty() else 0, mapper.GetTracingMTime(),
+                            data.GetMTime() if data else 0))
         return self.render_window.GetSize(), cameras, volumes
 
     def push_frame(self):

@@ -113,7 +113,6 @@ struct vtkMRMLMultiMaterialVolumeRenderingPipeline::Internals
   LabelMapInputs LabelMapExported;
   std::string MaterialDescription = "\n"; // preset and JSON last applied ("\n": none yet)
 
-  std::vector<double> ClipPlanes; // the planes last applied, by value
   vtkNew<vtkMatrix4x4> Matrix;
 
   vtkWeakPointer<vtkRenderer> Renderer;
@@ -284,17 +283,12 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateGeometry()
                                 << "is rendered");
     parent->GetMatrixTransformToWorld(toWorld);
   }
+  // The mapper compares the matrix by value: the same one again restarts nothing.
   vtkNew<vtkMatrix4x4> matrix;
   vtkMatrix4x4::Multiply4x4(toWorld, ijkToRas, matrix);
-  bool same = true;
-  for (int i = 0; i < 16; ++i)
-    same = same && matrix->GetData()[i] == in.Matrix->GetData()[i];
-  if (!same)
-  {
-    in.Matrix->DeepCopy(matrix);
-    in.Volume->SetUserMatrix(in.Matrix);
-    in.Volume->Modified();
-  }
+  in.Matrix->DeepCopy(matrix);
+  in.Volume->SetUserMatrix(in.Matrix);
+  in.Volume->Modified();
 }
 
 // The volume property node's property, as it is (rendering never changes
@@ -346,34 +340,25 @@ void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateProperty()
 }
 
 // Cropping by the ROI: its six faces, normals inward, as clipping planes in
-// world space (they change the mapper only when their values change).
+// world space (the mapper compares them by value: the same planes again
+// restart nothing).
 void vtkMRMLMultiMaterialVolumeRenderingPipeline::UpdateCropping()
 {
   Internals& in = *this->Internal;
   auto* node = vtkMRMLMultiMaterialVolumeRenderingDisplayNode::SafeDownCast(this->GetDisplayNode());
-  std::vector<double> values;
+  in.Mapper->RemoveAllClippingPlanes();
   vtkNew<vtkPlanes> planes;
   if (auto* roi = vtkMRMLMarkupsROINode::SafeDownCast(node->GetROINode()); roi && node->GetCroppingEnabled())
   {
     roi->GetPlanesWorld(planes, !roi->GetInsideOut());
     for (int i = 0; i < planes->GetNumberOfPlanes(); ++i)
     {
-      vtkPlane* plane = planes->GetPlane(i);
-      values.insert(values.end(), plane->GetOrigin(), plane->GetOrigin() + 3);
-      values.insert(values.end(), plane->GetNormal(), plane->GetNormal() + 3);
+      vtkNew<vtkPlane> plane; // a copy: vtkPlanes hands out one plane object, reused
+      plane->SetOrigin(planes->GetPlane(i)->GetOrigin());
+      plane->SetNormal(planes->GetPlane(i)->GetNormal());
+      in.Mapper->AddClippingPlane(plane);
     }
   }
-  if (values == in.ClipPlanes)
-    return;
-  in.Mapper->RemoveAllClippingPlanes();
-  for (size_t i = 0; i < values.size(); i += 6)
-  {
-    vtkNew<vtkPlane> plane;
-    plane->SetOrigin(values[i], values[i + 1], values[i + 2]);
-    plane->SetNormal(values[i + 3], values[i + 4], values[i + 5]);
-    in.Mapper->AddClippingPlane(plane);
-  }
-  in.ClipPlanes = std::move(values);
 }
 
 void vtkMRMLMultiMaterialVolumeRenderingPipeline::PrintSelf(ostream& os, vtkIndent indent)

@@ -202,6 +202,40 @@ class ViewTest(unittest.TestCase):
         self.view.refine()
         self.assertEqual(self.view.pixels(), self.before, "cropping off: the same image as before")
 
+    def test_the_same_roi_and_matrix_again_restart_nothing(self):
+        """The pipeline sets the ROI's planes and the volume's matrix on
+        every update, without comparing them with the last; the mapper
+        compares them by value. An update with nothing changed (the ROI, the
+        volume and the display node modified, their values the same) keeps
+        the converged samples. Catches a mapper that restarts on a plane or
+        matrix set again (the film thrown away at every node event)."""
+        roi = self.s.scene.AddNewNodeByClass("vtkMRMLMarkupsROINode", "crop")
+        bounds = [0.0] * 6
+        self.volume.GetRASBounds(bounds)
+        roi.SetXYZ((bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2, (bounds[4] + bounds[5]) / 2)
+        roi.SetRadiusXYZ((bounds[1] - bounds[0]) / 3, (bounds[3] - bounds[2]) / 3, (bounds[5] - bounds[4]) / 3)
+        self.display.SetAndObserveROINodeID(roi.GetID())
+        self.display.SetCroppingEnabled(True)
+        self.view.refine()
+        mapper = self.view.mapper()
+        self.assertTrue(mapper.IsConverged())
+        converged, counts = mapper.GetAccumulatedSamples(), self.counts()
+        planes = mapper.GetClippingPlanes().GetNumberOfItems()
+        self.assertEqual(planes, 6, "the ROI's six faces")
+        first = mapper.GetClippingPlanes().GetItem(0)  # held: a new plane cannot take its address
+        roi.Modified()
+        self.volume.Modified()
+        self.display.Modified()
+        self.view.render()
+        self.assertEqual(mapper.GetClippingPlanes().GetNumberOfItems(), planes)
+        self.assertIsNot(mapper.GetClippingPlanes().GetItem(0), first, "the pipeline set the planes again")
+        self.assertEqual(self.counts(), counts, "no restart")
+        self.assertEqual(mapper.GetAccumulatedSamples(), converged, "the converged samples kept")
+        # A moved ROI still restarts.
+        roi.SetXYZ((bounds[0] + bounds[1]) / 2 + 5.0, (bounds[2] + bounds[3]) / 2, (bounds[4] + bounds[5]) / 2)
+        self.view.render()
+        self.assertEqual(self.counts()[2], counts[2] + 1, "a moved ROI restarts")
+
     def test_hidden_in_one_view_only(self):
         second = self.s.add_view("View2")
         second.renderer.GetActiveCamera().DeepCopy(self.view.renderer.GetActiveCamera())
