@@ -236,8 +236,9 @@ int vtkMultiMaterialVolumeRepresentation::RequestData(
 }
 
 // The label map: the named point array as the mapper's mask, and for each
-// label a material by the mapper's one label rule (a colour of the palette,
-// opacity 1). ParaView's volume property is left as the user set it.
+// label a material by the mapper's one label rule (the front ends' default
+// label colour, opacity 1). ParaView's volume property is left as the user
+// set it.
 void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
 {
   vtkImageData* image = vtkImageData::SafeDownCast(this->Cache);
@@ -278,16 +279,11 @@ void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
     vtkWarningMacro(
       "the label map array \"" << this->LabelMapArray << "\" has more than 64 labels: only the first 64 are materials");
   }
-  // A qualitative palette (ColorBrewer's Set1 and Dark2).
-  static const double palette[][3] = { { 0.89, 0.10, 0.11 }, { 0.22, 0.49, 0.72 }, { 0.30, 0.69, 0.29 },
-    { 0.60, 0.31, 0.64 }, { 1.00, 0.50, 0.00 }, { 1.00, 1.00, 0.20 }, { 0.65, 0.34, 0.16 }, { 0.97, 0.51, 0.75 },
-    { 0.11, 0.62, 0.47 }, { 0.85, 0.37, 0.01 }, { 0.46, 0.44, 0.70 }, { 0.40, 0.65, 0.12 } };
-  const int colours = static_cast<int>(sizeof(palette) / sizeof(palette[0]));
   this->Mapper()->RemoveAllLabelMaterials();
-  int index = 0;
   for (int label : found)
   {
-    const double* c = palette[index++ % colours];
+    double c[3];
+    vtkMultiMaterialVolumeMapper::GetDefaultLabelColor(label, c);
     this->Mapper()->SetLabelMaterial(label, c[0], c[1], c[2], 1.0);
   }
 }

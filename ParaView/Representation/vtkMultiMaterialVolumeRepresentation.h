@@ -24,7 +24,8 @@
  * the processes where they are visible.)
  *
  * A second point array may be named as a label map (SetLabelMapArray):
- * its labels become materials of their own, coloured from a fixed palette
+ * its labels become materials of their own, in the front ends' default
+ * label colours (vtkMultiMaterialVolumeMapper::GetDefaultLabelColor)
  * with the representation's opacity function.
  */
 #ifndef vtkMultiMaterialVolumeRepresentation_h

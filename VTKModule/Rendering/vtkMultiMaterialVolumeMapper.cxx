@@ -934,6 +934,14 @@ int vtkMultiMaterialVolumeMapper::GetNumberOfRestarts()
   return this->Internal->Restarts;
 }
 
+void vtkMultiMaterialVolumeMapper::GetDefaultLabelColor(int label, double rgb[3])
+{
+  const mmrtm::RGB c = mmrtm::DefaultLabelColor(label);
+  rgb[0] = c.r;
+  rgb[1] = c.g;
+  rgb[2] = c.b;
+}
+
 double vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity()
 {
   return mmrtm::kLabelDensityAtFullOpacity;

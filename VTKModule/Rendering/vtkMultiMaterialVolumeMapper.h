@@ -605,6 +605,14 @@ public:
   double GetLastRefitSeconds();
 
   /**
+   * The colour of a label that nothing else names a colour for (no colour
+   * table, no segment colour): the one default of the front ends (the
+   * viewer's label list, ParaView's label-map array), well apart for
+   * neighbouring labels; label 0, the background, is black.
+   */
+  static void GetDefaultLabelColor(int label, double rgb[3]);
+
+  /**
    * The extinction per millimetre of a label shown at opacity 1 (2.5: as
    * opaque as the organs of the ct-organs preset): the one density rule by
    * which front ends turn a label's opacity into a material (Slicer's
