@@ -9,6 +9,7 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCommand.h>
+#include <vtkIdList.h>
 #include <vtkImageAccumulate.h>
 #include <vtkImageData.h>
 #include <vtkMatrix3x3.h>
@@ -161,24 +162,20 @@ QVector<LabelEntry> ViewerScene::LabelsPresent(vtkImageData* labels, vtkImageDat
   for (int axis = 0; axis < 3; ++axis)
     if (b[2 * axis] > a[2 * axis + 1] || b[2 * axis + 1] < a[2 * axis])
       throw std::runtime_error(path + ": the label map does not overlap the volume");
-  // The labels present: a histogram over the ids.
   const double* range = labels->GetScalarRange();
   if (range[0] < 0 || range[1] > 65535 || range[1] < 1)
     throw std::runtime_error(path + ": not a label map (values from " + std::to_string(range[0]) + " to " +
                              std::to_string(range[1]) + ")");
-  vtkNew<vtkImageAccumulate> count;
-  count->SetInputData(labels);
-  const int top = int(std::floor(range[1]));
-  count->SetComponentExtent(0, top, 0, 0, 0, 0);
-  count->SetComponentOrigin(0, 0, 0);
-  count->SetComponentSpacing(1, 1, 1);
-  count->Update();
+  vtkNew<vtkIdList> ids;
+  if (!vtkMultiMaterialVolumeMapper::GetLabelsPresent(labels, ids))
+    throw std::runtime_error(path + ": not a label map (its values are not whole numbers)");
   QVector<LabelEntry> present;
-  for (int id = 1; id <= top; ++id)
-    if (count->GetOutput()->GetScalarComponentAsDouble(id, 0, 0, 0) > 0) {
-      const RGB c = DefaultLabelColor(id);
-      present.push_back({id, QString("label_%1").arg(id), QColor::fromRgbF(c[0], c[1], c[2])});
-    }
+  for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i) {
+    const int id = static_cast<int>(ids->GetId(i));
+    double c[3];
+    vtkMultiMaterialVolumeMapper::GetDefaultLabelColor(id, c);
+    present.push_back({id, QString("label_%1").arg(id), QColor::fromRgbF(c[0], c[1], c[2])});
+  }
   return present;
 }
 
@@ -205,25 +202,16 @@ void ViewerScene::RefreshLabelEntries() {
   if (!labelTablePath_.empty()) table = ReadLabelTable(labelTablePath_);
   json doc = description_;
   if (!doc.contains("label_materials")) doc["label_materials"] = DefaultLabelMaterials();
-  doc.erase("material_tfs");
-  const json expanded = ExpandLabelMaterials(doc, ids, labelTablePath_.empty() ? nullptr : &table);
-  if (!expanded.contains("material_tfs")) return;
-  for (const json& point : expanded["material_tfs"][0]["points"]) {
-    const int id = point[0].get<int>();
+  for (const auto& [id, look] : LabelLooksOf(doc, ids, labelTablePath_.empty() ? nullptr : &table)) {
     if (std::find(editedLabels_.begin(), editedLabels_.end(), id) != editedLabels_.end()) continue;
-    const std::string name = point[1].get<std::string>();
-    const json& m = expanded["materials"][name];
     for (LabelEntry& l : labels_)
       if (l.id == id) {
         if (const mmrtm::LabelEntry* entry = labelTablePath_.empty() ? nullptr : table.Find(id))
           l.name = QString::fromStdString(entry->name);
-        const json albedo = m.value("albedo", json({1.0, 1.0, 1.0}));
-        l.color = QColor::fromRgbF(std::clamp(albedo[0].get<double>(), 0.0, 1.0),
-                                   std::clamp(albedo[1].get<double>(), 0.0, 1.0),
-                                   std::clamp(albedo[2].get<double>(), 0.0, 1.0));
-        l.surfaceProbability = m.value("surface_probability", 0.0);
-        l.roughness = m.value("roughness", 0.5);
-        l.opacity = LabelOpacity(m.value("density", 1.0));
+        l.color = QColor::fromRgbF(look.color[0], look.color[1], look.color[2]);
+        l.surfaceProbability = look.surface.value("surface_probability", 0.0);
+        l.roughness = look.surface.value("roughness", 0.5);
+        l.opacity = look.opacity;
       }
   }
 }
@@ -355,7 +343,7 @@ void ViewerScene::LoadScene(const std::string& path) {
 }
 
 void ViewerScene::SaveScene(const std::string& path, vtkCamera* camera, int width, int height) const {
-  json doc = Description();
+  json doc = SavedDescription();
   doc["volumes"] = {{"scalars", {{"file", volumePath_}}}};
   if (labelMap_) doc["volumes"]["labels"] = {{"file", labelsPath_}, {"interpolation", "nearest"}};
   if (!series_.empty())
@@ -523,14 +511,6 @@ json ViewerScene::Description() const {
   doc.erase("volumes");
   if (labelMap_) {
     if (!doc.contains("label_materials")) doc["label_materials"] = DefaultLabelMaterials();
-    json& classes = doc["label_materials"]["classes"];
-    // The labels the user edited, first, each a class of its own.
-    for (int id : editedLabels_)
-      for (const LabelEntry& l : labels_)
-        if (l.id == id)
-          classes.insert(
-              classes.begin(),
-              json::object({{"ids", json::array({id})}, {"color", "material"}, {"material", LabelMaterial(Look(l))}}));
     if (!labelTablePath_.empty()) doc["label_table"] = labelTablePath_;
   } else {
     doc.erase("label_materials");
@@ -566,9 +546,28 @@ json ViewerScene::Description() const {
   return doc;
 }
 
+std::map<int, LabelLook> ViewerScene::EditedLooks() const {
+  std::map<int, LabelLook> looks;
+  for (int id : editedLabels_)
+    for (const LabelEntry& l : labels_)
+      if (l.id == id) looks[id] = Look(l);
+  return looks;
+}
+
+json ViewerScene::SavedDescription() const {
+  return labelMap_ ? WithLabelLooks(Description(), EditedLooks()) : Description();
+}
+
 void ViewerScene::Apply() {
-  // The property keeps its modification time when the description is the
-  // one it holds: the mapper then neither refits nor restarts.
+  // The edited labels by the mapper's one label route, and the description.
+  // Both are compared by value: what is set again as it was neither refits
+  // nor restarts.
+  mapper_->RemoveAllLabelMaterials();
+  mapper_->RemoveAllLabelMaterialParameters();
+  for (const auto& [id, look] : EditedLooks()) {
+    mapper_->SetLabelMaterial(id, look.color[0], look.color[1], look.color[2], look.visible ? look.opacity : 0.0);
+    mapper_->SetLabelMaterialParameters(id, look.surface.dump().c_str());
+  }
   materials_->SetScene(Description());
 }
 

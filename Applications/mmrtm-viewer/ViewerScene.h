@@ -11,6 +11,7 @@
 // and the problem, and leaves the scene as it was.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ class vtkImageData;
 class vtkMultiMaterialProperty;
 class vtkMultiMaterialVolumeMapper;
 class vtkVolume;
+
+namespace mmrtm {
+struct LabelLook;
+}
 
 namespace mmrtm::viewer {
 
@@ -89,8 +94,12 @@ class ViewerScene {
   void SetSettings(const RenderSettings& settings);
 
   // The description the mapper renders now (with the label classes and
-  // lights of the viewer), and handing it to the mapper.
+  // lights of the viewer; the labels the user edited reach the mapper as
+  // its label materials), the same with the edited labels as classes of
+  // their own (what SaveScene writes, for mmrtm-render), and handing the
+  // description and the edited labels to the mapper.
   nlohmann::json Description() const;
+  nlohmann::json SavedDescription() const;
   void Apply();
 
  private:
@@ -99,6 +108,7 @@ class ViewerScene {
   void AdoptLabels(vtkImageData* labels, const std::string& path, const QVector<LabelEntry>& present);
   void ResetFromDescription();
   void RefreshLabelEntries();
+  std::map<int, LabelLook> EditedLooks() const;  // the edited rows by the one label rule
   nlohmann::json& DensityTF(const std::string& material);
   nlohmann::json& AlbedoTF(const std::string& material);
 

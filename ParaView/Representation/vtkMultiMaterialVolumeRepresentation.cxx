@@ -3,10 +3,12 @@
 #include "vtkCommand.h"
 #include "vtkCommunicator.h"
 #include "vtkDataArray.h"
+#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
 #include "vtkPVRenderView.h"
@@ -18,7 +20,7 @@
 
 #include "vtkSampleParallelVolumeMapper.h"
 
-#include <set>
+#include <algorithm>
 
 vtkStandardNewMacro(vtkMultiMaterialVolumeRepresentation);
 
@@ -267,21 +269,17 @@ void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
   this->Mapper()->SetMaskTypeToLabelMap();
 
   // Up to 64 labels (0 is the background): more is not a label map.
-  std::set<int> found;
-  for (vtkIdType i = 0, n = labels->GetNumberOfTuples(); i < n && found.size() <= 64; ++i)
-  {
-    const int label = static_cast<int>(labels->GetTuple1(i));
-    if (label != 0)
-      found.insert(label);
-  }
-  if (found.size() > 64)
+  vtkNew<vtkIdList> found;
+  vtkMultiMaterialVolumeMapper::GetLabelsPresent(mask, found);
+  if (found->GetNumberOfIds() > 64)
   {
     vtkWarningMacro(
       "the label map array \"" << this->LabelMapArray << "\" has more than 64 labels: only the first 64 are materials");
   }
   this->Mapper()->RemoveAllLabelMaterials();
-  for (int label : found)
+  for (vtkIdType i = 0; i < std::min<vtkIdType>(found->GetNumberOfIds(), 64); ++i)
   {
+    const int label = static_cast<int>(found->GetId(i));
     double c[3];
     vtkMultiMaterialVolumeMapper::GetDefaultLabelColor(label, c);
     this->Mapper()->SetLabelMaterial(label, c[0], c[1], c[2], 1.0);

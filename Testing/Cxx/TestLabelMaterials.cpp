@@ -173,6 +173,35 @@ TEST(LabelMaterials, ALabelsLookOutOfRangeIsAnErrorNamingIt) {
   }
 }
 
+// A front end's edited labels (the mapper's SetLabelMaterial over a
+// description, the viewer's saved scene) win over the description's classes,
+// and a look read back from the description is the look put in. Catches
+// looks put after the classes (the "*" class would win), a document without
+// "label_materials" left without the looks, and a look that does not come
+// back through LabelLooksOf.
+TEST(LabelMaterials, LabelLooksWinOverTheDescriptionsClassesAndReadBack) {
+  const LabelTable table = Table();
+  LabelLook look;
+  look.color = {0.1, 0.2, 0.9};
+  look.opacity = 0.5;
+  look.surface = {{"roughness", 0.3}};
+  const json doc = WithLabelLooks(Classes(), {{3, look}});
+  const std::map<int, LabelLook> read = LabelLooksOf(doc, {1, 2, 3, 9}, &table);
+  ASSERT_EQ(read.size(), 4u);
+  EXPECT_TRUE(read.at(3) == look);
+  EXPECT_DOUBLE_EQ(read.at(1).opacity, LabelOpacity(4));                // aorta: its class
+  EXPECT_EQ(read.at(2).color, (std::array<double, 3>{1.0, 0.0, 0.0}));  // vertebra: the table's colour
+  EXPECT_DOUBLE_EQ(read.at(9).opacity, LabelOpacity(2));                // the "*" class
+  // Without classes of its own: the looks alone, other labels unclaimed.
+  const json bare = WithLabelLooks(json::object(), {{3, look}});
+  EXPECT_EQ(bare["label_materials"]["proxy"], "labels");
+  const std::map<int, LabelLook> alone = LabelLooksOf(bare, {1, 3}, nullptr);
+  ASSERT_EQ(alone.size(), 1u);
+  EXPECT_TRUE(alone.at(3) == look);
+  EXPECT_TRUE(LabelLooksOf(json::object(), {1, 3}, nullptr).empty());
+  EXPECT_EQ(WithLabelLooks(Classes(), {}), Classes());
+}
+
 // The presets and the rule agree: ct-organs' class for any other label is
 // a label at opacity 1. Catches a preset or a rule changed alone.
 TEST(LabelMaterials, TheOrgansPresetsOtherLabelsAreAtFullOpacity) {

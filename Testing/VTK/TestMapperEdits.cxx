@@ -54,6 +54,7 @@
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
 
+#include "vtkMultiMaterialProperty.h"
 #include "vtkMultiMaterialVolumeMapper.h"
 
 namespace
@@ -475,6 +476,45 @@ std::vector<Case> Cases()
   c.push_back({ "label-look-removed", Input::HeadLabels, looks, [](Objects& o) { o.mapper->RemoveLabelMaterial(1); } });
   c.push_back({ "label-look-same-values", Input::HeadLabels, looks,
     [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.6); }, false, Work::Display });
+  // A front end that sets all its labels at each update (ParaView's
+  // representation): removed and set again as they were, no change.
+  c.push_back({ "label-looks-set-again", Input::HeadLabels, looks,
+    [](Objects& o)
+    {
+      o.mapper->RemoveAllLabelMaterials();
+      o.mapper->SetLabelMaterial(1, 0.9, 0.2, 0.1, 0.6);
+    },
+    false, Work::Display });
+  // Over a multi-material description (the viewer's label list): a look
+  // is a label class of its own, ahead of the description's.
+  const auto described = [](Objects& o)
+  {
+    HeadFunctions(o);
+    vtkNew<vtkMultiMaterialProperty> description;
+    description->SetPreset("ct-organs");
+    o.mapper->SetMultiMaterialProperty(description);
+  };
+  c.push_back({ "description-label-look", Input::HeadLabels, described,
+    [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.1, 0.9, 0.2, 1.0); } });
+  c.push_back({ "description-label-look-opacity", Input::HeadLabels,
+    [&](Objects& o)
+    {
+      described(o);
+      o.mapper->SetLabelMaterial(1, 0.1, 0.9, 0.2, 1.0);
+    },
+    [](Objects& o) { o.mapper->SetLabelMaterial(1, 0.1, 0.9, 0.2, 0.1); } });
+  c.push_back({ "description-label-look-set-again", Input::HeadLabels,
+    [&](Objects& o)
+    {
+      described(o);
+      o.mapper->SetLabelMaterial(1, 0.1, 0.9, 0.2, 1.0);
+    },
+    [](Objects& o)
+    {
+      o.mapper->RemoveAllLabelMaterials();
+      o.mapper->SetLabelMaterial(1, 0.1, 0.9, 0.2, 1.0);
+    },
+    false, Work::Display });
 
   // The mapper's own settings.
   c.push_back({ "seed", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->SetSeed(kSeed + 1); } });

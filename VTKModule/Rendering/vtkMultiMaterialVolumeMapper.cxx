@@ -20,6 +20,7 @@
 #include <vtkDataArray.h>
 #include <vtkDemandDrivenPipeline.h>
 #include <vtkFloatArray.h>
+#include <vtkIdList.h>
 #include <vtkNew.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkContourValues.h>
@@ -159,15 +160,37 @@ struct vtkMultiMaterialVolumeMapper::Internals
   std::shared_ptr<mmrtm::EnvironmentMap> Environment; // converted from the texture
   vtkMTimeType EnvironmentTime = 0;
   double EnvironmentScale = 0;
-  // SetLabelMaterial and SetLabelMaterialParameters, by label, and when
-  // either last changed.
+  // SetLabelMaterial and SetLabelMaterialParameters, by label.
   std::map<int, mmrtm::LabelLook> LabelLooks;
   std::map<int, std::string> LabelMaterialParameters;
-  vtkTimeStamp LabelMaterialsTime;
-  void LabelMaterialsModified(vtkMultiMaterialVolumeMapper* mapper)
+  // When they last changed as values: labels removed and set again to the
+  // looks they had (a front end that sets all its labels at each update)
+  // are no change.
+  vtkMTimeType LabelMaterialsTime()
   {
-    this->LabelMaterialsTime.Modified();
-    mapper->Modified();
+    if (this->LabelLooks != this->LabelLooksSeen || this->LabelMaterialParameters != this->LabelParametersSeen)
+    {
+      this->LabelLooksSeen = this->LabelLooks;
+      this->LabelParametersSeen = this->LabelMaterialParameters;
+      this->LabelMaterialsChanged.Modified();
+    }
+    return this->LabelMaterialsChanged.GetMTime();
+  }
+  std::map<int, mmrtm::LabelLook> LabelLooksSeen;
+  std::map<int, std::string> LabelParametersSeen;
+  vtkTimeStamp LabelMaterialsChanged;
+  // The looks with their parameters (a description's label classes).
+  std::map<int, mmrtm::LabelLook> LabelLooksWithParameters() const
+  {
+    std::map<int, mmrtm::LabelLook> looks = this->LabelLooks;
+    for (auto& [label, look] : looks)
+      if (const auto found = this->LabelMaterialParameters.find(label); found != this->LabelMaterialParameters.end())
+      {
+        look.surface = mmrtm::ParseJson(found->second, "label " + std::to_string(label) + " material");
+        if (!look.surface.is_object())
+          throw mmrtm::InputError("label " + std::to_string(label) + " material: expected a JSON object");
+      }
+    return looks;
   }
   // The inputs as the scene and the film were last made from them; each
   // render compares what it finds with these (ChangesSince).
@@ -612,7 +635,7 @@ vtkMTimeType vtkMultiMaterialVolumeMapper::GetTracingMTime()
   vtkTexture* environment = in.EnvironmentTexture;
   const std::vector<double> now = TracingInputs(this,
     { in.Mask ? in.Mask->GetMTime() : 0, in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0,
-      in.LabelMaterialsTime.GetMTime(), environment ? environment->GetMTime() : 0,
+      in.LabelMaterialsTime(), environment ? environment->GetMTime() : 0,
       environment && environment->GetInput() ? environment->GetInput()->GetMTime() : 0 });
   if (!SameValues(now, in.TracingInputsSeen))
   {
@@ -680,7 +703,7 @@ void vtkMultiMaterialVolumeMapper::SetLabelMaterial(int label, double r, double 
   if (found != looks.end() && found->second.color == look.color && found->second.opacity == opacity)
     return;
   looks[label] = look;
-  this->Internal->LabelMaterialsModified(this);
+  this->Modified();
 }
 
 bool vtkMultiMaterialVolumeMapper::GetLabelMaterial(int label, double rgbo[4])
@@ -697,7 +720,7 @@ bool vtkMultiMaterialVolumeMapper::GetLabelMaterial(int label, double rgbo[4])
 void vtkMultiMaterialVolumeMapper::RemoveLabelMaterial(int label)
 {
   if (this->Internal->LabelLooks.erase(label))
-    this->Internal->LabelMaterialsModified(this);
+    this->Modified();
 }
 
 void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterials()
@@ -705,7 +728,7 @@ void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterials()
   if (this->Internal->LabelLooks.empty())
     return;
   this->Internal->LabelLooks.clear();
-  this->Internal->LabelMaterialsModified(this);
+  this->Modified();
 }
 
 void vtkMultiMaterialVolumeMapper::SetLabelMaterialParameters(int label, const char* json)
@@ -724,7 +747,7 @@ void vtkMultiMaterialVolumeMapper::SetLabelMaterialParameters(int label, const c
       return;
     parameters[label] = json;
   }
-  this->Internal->LabelMaterialsModified(this);
+  this->Modified();
 }
 
 const char* vtkMultiMaterialVolumeMapper::GetLabelMaterialParameters(int label)
@@ -738,7 +761,7 @@ void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterialParameters()
   if (this->Internal->LabelMaterialParameters.empty())
     return;
   this->Internal->LabelMaterialParameters.clear();
-  this->Internal->LabelMaterialsModified(this);
+  this->Modified();
 }
 
 double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
@@ -940,6 +963,31 @@ void vtkMultiMaterialVolumeMapper::GetDefaultLabelColor(int label, double rgb[3]
   rgb[0] = c.r;
   rgb[1] = c.g;
   rgb[2] = c.b;
+}
+
+bool vtkMultiMaterialVolumeMapper::GetLabelsPresent(vtkImageData* labelMap, vtkIdList* labels)
+{
+  labels->Reset();
+  try
+  {
+    if (!labelMap)
+      throw mmrtm::InputError("no label map");
+    vtkDataArray* scalars = labelMap->GetPointData()->GetScalars();
+    if (scalars && scalars->GetNumberOfComponents() != 1)
+      throw mmrtm::InputError("the label map has " + std::to_string(scalars->GetNumberOfComponents()) +
+        " components, not 1");
+    const mmrtm::HostVolume volume =
+      mmrtm::ImageDataToHostVolume(labelMap, scalars, 0, "the label map", mmrtm::Interpolation::Nearest);
+    for (const int label : mmrtm::LabelIdsPresent(volume))
+      labels->InsertNextId(label);
+    return true;
+  }
+  catch (const std::exception& e)
+  {
+    labels->Reset();
+    vtkGenericWarningMacro("GetLabelsPresent: " << e.what());
+    return false;
+  }
 }
 
 double vtkMultiMaterialVolumeMapper::GetLabelDensityAtFullOpacity()
@@ -1186,7 +1234,7 @@ vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInput
   now.Materials.Property = property;
   now.Materials.PropertyTime = PropertyMTime(property);
   now.Materials.MultiMaterialTime = in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0;
-  now.Materials.LabelMaterialsTime = in.LabelMaterialsTime.GetMTime();
+  now.Materials.LabelMaterialsTime = in.LabelMaterialsTime();
 
   // Camera, lights, matrix, viewport (by value), clipping, the environment,
   // the opaque geometry (its depth), and the mapper's own settings.
@@ -1256,7 +1304,9 @@ vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince
   Changes c;
   c.Proxies = !this->Internal->HasScene || !(now.Proxies == built.Proxies);
   const bool description = now.Proxies.MultiMaterial != nullptr;
-  c.Description = description && now.Materials.MultiMaterialTime != built.Materials.MultiMaterialTime;
+  c.Description = description &&
+    (now.Materials.MultiMaterialTime != built.Materials.MultiMaterialTime ||
+      now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime);
   c.Materials = !description &&
     (now.Materials.Property != built.Materials.Property || now.Materials.PropertyTime != built.Materials.PropertyTime ||
       now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime ||
@@ -1288,6 +1338,7 @@ void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
   in.Scene.MarkDataModified();
   in.Built.Proxies = now.Proxies;
   in.Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime; // parsed over them
+  in.Built.Materials.LabelMaterialsTime = now.Materials.LabelMaterialsTime;
   ++in.SceneBuilds;
 }
 
@@ -1297,6 +1348,7 @@ void vtkMultiMaterialVolumeMapper::UpdateDescription(const InputState& now)
   // proxies as they are, and refitted.
   this->ReparseMultiMaterialScene();
   this->Internal->Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime;
+  this->Internal->Built.Materials.LabelMaterialsTime = now.Materials.LabelMaterialsTime;
 }
 
 void vtkMultiMaterialVolumeMapper::UpdateMaterials(const InputState& now)
@@ -1738,11 +1790,15 @@ void vtkMultiMaterialVolumeMapper::UpdateEnvironment()
 void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
 {
   // The description over the mapper's volumes: its input as "scalars" (and
-  // the mask as "labels"); the camera and image size stay VTK's.
+  // the mask as "labels"); the camera and image size stay VTK's. The
+  // labels' looks (SetLabelMaterial) are classes of the description's
+  // label materials, ahead of its own.
   Internals& in = *this->Internal;
   nlohmann::json doc = in.MultiMaterial->GetScene();
   doc.erase("camera");
   doc.erase("volumes"); // a description's own files are not the mapper's data
+  if (in.Layout.labels >= 0)
+    doc = mmrtm::WithLabelLooks(std::move(doc), in.LabelLooksWithParameters());
   mmrtm::SceneInputs inputs;
   inputs.volumes["scalars"] = std::move(in.Scene.proxies[0]);
   for (size_t i = 1; i < in.Scene.proxies.size(); ++i)

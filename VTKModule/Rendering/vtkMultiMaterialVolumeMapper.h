@@ -58,6 +58,7 @@
 #include <vector> // for std::vector
 
 class vtkDataArray;
+class vtkIdList;
 class vtkImageData;
 class vtkVolumeProperty;
 class vtkMultiMaterialProperty;
@@ -331,9 +332,14 @@ public:
    * gradient opacity, shading from the volume property, surface parameters
    * from SetLabelMaterialParameters. It takes the place of the property's
    * label functions for that label; a label without one keeps them (or,
-   * without those, shows the property's own functions). Setting the same
-   * values again changes nothing. Values outside [0, 1] are an error at
-   * the next render. 3D Slicer's segments reach the mapper this way.
+   * without those, shows the property's own functions). Over a
+   * multi-material description (SetMultiMaterialProperty) it is a class of
+   * the description's "label_materials" of its own, ahead of the
+   * description's classes. The looks are compared by value: setting the
+   * same values again, or removing the labels and setting them again as
+   * they were, changes nothing. Values outside [0, 1] are an error at the
+   * next render. 3D Slicer's segments, ParaView's label-map array and the
+   * viewer's label list reach the mapper this way.
    */
   void SetLabelMaterial(int label, double r, double g, double b, double opacity);
   // The label's colour and opacity in rgbo; false (rgbo untouched) without one.
@@ -346,7 +352,9 @@ public:
   /**
    * With a LABELMAP mask: surface and phase parameters of label `label`'s
    * material, which VTK's label functions cannot say (its colour, opacity
-   * and gradient opacity stay the property's or SetLabelMaterial's). `json` is an object with
+   * and gradient opacity stay the property's or SetLabelMaterial's; over a
+   * multi-material description, only a label given SetLabelMaterial takes
+   * them). `json` is an object with
    * any of "roughness", "metallic", "surface_probability" (0 to 1),
    * "anisotropy" (-1 to 1) and "emission" ([r, g, b]); an unknown key or a
    * value out of range is an error at the next render. A null or empty
@@ -611,6 +619,15 @@ public:
    * neighbouring labels; label 0, the background, is black.
    */
   static void GetDefaultLabelColor(int label, double rgb[3]);
+
+  /**
+   * The labels a label map holds: the distinct non-zero values of its
+   * scalars (one component), ascending, put in `labels`. The front ends'
+   * one scan (the viewer's label list, ParaView's label-map array). False,
+   * with `labels` empty and a warning naming the problem, for scalars that
+   * are missing, not one component, or not integers.
+   */
+  static bool GetLabelsPresent(vtkImageData* labelMap, vtkIdList* labels);
 
   /**
    * The extinction per millimetre of a label shown at opacity 1 (2.5: as

@@ -167,6 +167,44 @@ json LabelMaterial(const LabelLook& look) {
   return m;
 }
 
+json WithLabelLooks(json doc, const std::map<int, LabelLook>& looks) {
+  if (looks.empty()) return doc;
+  if (!doc.contains("label_materials")) doc["label_materials"] = {{"proxy", "labels"}, {"classes", json::array()}};
+  json& block = doc["label_materials"];
+  if (!block.is_object()) Fail("label_materials", "expected an object");
+  json classes = json::array();
+  for (const auto& [label, look] : looks)
+    classes.push_back({{"ids", {label}}, {"color", "material"}, {"material", LabelMaterial(look)}});
+  if (block.contains("classes")) {
+    if (!block["classes"].is_array()) Fail("label_materials.classes", "expected a list of classes");
+    for (const json& c : block["classes"]) classes.push_back(c);
+  }
+  block["classes"] = classes;
+  return doc;
+}
+
+std::map<int, LabelLook> LabelLooksOf(const json& doc, const std::vector<int>& ids, const LabelTable* table) {
+  std::map<int, LabelLook> looks;
+  if (!doc.contains("label_materials")) return looks;
+  json labelsOnly = doc;
+  labelsOnly.erase("material_tfs");
+  const json expanded = ExpandLabelMaterials(labelsOnly, ids, table);
+  if (!expanded.contains("material_tfs")) return looks;
+  static const char* const kSurface[] = {"roughness", "metallic", "surface_probability", "anisotropy", "emission"};
+  for (const json& point : expanded["material_tfs"][0]["points"]) {
+    const json& m = expanded["materials"][point[1].get<std::string>()];
+    LabelLook look;
+    const json albedo = m.value("albedo", json({1.0, 1.0, 1.0}));
+    for (int c = 0; c < 3; ++c)
+      look.color[c] = std::clamp(albedo.is_array() ? albedo[c].get<double>() : albedo.get<double>(), 0.0, 1.0);
+    look.opacity = LabelOpacity(m.value("density", 1.0));
+    for (const char* key : kSurface)
+      if (m.contains(key)) look.surface[key] = m[key];
+    looks[point[0].get<int>()] = look;
+  }
+  return looks;
+}
+
 double LabelOpacity(double density) { return std::clamp(density / kLabelDensityAtFullOpacity, 0.0, 1.0); }
 
 }  // namespace mmrtm

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ struct LabelLook {
   double opacity = 1.0;
   bool visible = true;
   nlohmann::json surface = nlohmann::json::object();
+  bool operator==(const LabelLook& o) const {
+    return color == o.color && opacity == o.opacity && visible == o.visible && surface == o.surface;
+  }
 };
 
 // The extinction, per millimetre, of a label at opacity 1: as opaque as the
@@ -66,5 +70,20 @@ std::vector<int> LabelIdsPresent(const HostVolume& labels);
 // Errors name the JSON path. A document without "label_materials" is
 // returned unchanged.
 nlohmann::json ExpandLabelMaterials(nlohmann::json doc, const std::vector<int>& ids, const LabelTable* table);
+
+// The document with each look a class of its own ({"ids": [label], "color":
+// "material", "material": LabelMaterial(look)}), ahead of the document's
+// own classes, so that the looks win. A document without "label_materials"
+// gets one over the proxy "labels" that claims just these labels. How a
+// front end's per-label edits (the mapper's SetLabelMaterial, the viewer's
+// label list) become part of a scene description.
+nlohmann::json WithLabelLooks(nlohmann::json doc, const std::map<int, LabelLook>& looks);
+
+// What doc's "label_materials" gives each of `ids` (ExpandLabelMaterials'
+// choice), as a look: the albedo as its colour, the density as its opacity
+// (LabelOpacity), the material's surface parameters. Labels that no class
+// claims are left out; so is every label when the document has no
+// "label_materials". Errors as ExpandLabelMaterials'.
+std::map<int, LabelLook> LabelLooksOf(const nlohmann::json& doc, const std::vector<int>& ids, const LabelTable* table);
 
 }  // namespace mmrtm

@@ -187,10 +187,16 @@ class TestMmrtmViewer : public QObject {
     entry.color = QColor(0, 0, 255);
     entry.opacity = 0.8;
     table->setLabel(liver, entry);
-    // The edited label's material by the one label rule: density 2.5/mm
-    // times its opacity, its colour as albedo (Slicer's segments too).
+    // The edited label reaches the mapper by its one label route
+    // (SetLabelMaterial, as Slicer's segments and ParaView's labels do), and
+    // the saved scene as a class of its own by the one label rule: density
+    // 2.5/mm times its opacity, its colour as albedo.
+    double rgbo[4] = {-1, -1, -1, -1};
+    QVERIFY(v.window.scene().Mapper()->GetLabelMaterial(entry.id, rgbo));
+    QCOMPARE(rgbo[2], 1.0);
+    QCOMPARE(rgbo[3], 0.8);
     auto labelMaterial = [&] {
-      const nlohmann::json description = v.window.scene().Description();
+      const nlohmann::json description = v.window.scene().SavedDescription();
       for (const nlohmann::json& c : description["label_materials"]["classes"])
         if (c.value("ids", nlohmann::json::array()) == nlohmann::json::array({entry.id})) return c["material"];
       return nlohmann::json();
@@ -205,6 +211,8 @@ class TestMmrtmViewer : public QObject {
     entry.visible = false;
     table->setLabel(liver, entry);
     QCOMPARE(labelMaterial()["density"].get<double>(), 0.0);
+    QVERIFY(v.window.scene().Mapper()->GetLabelMaterial(entry.id, rgbo));
+    QCOMPARE(rgbo[3], 0.0);
     // The edit reaches the mapper at its next render, which may wait for a
     // pass in flight: until it restarts, the count of 8 is the old image's.
     QVERIFY2(QTest::qWaitFor([&] { return m->GetNumberOfRestarts() > restarts; }, 120000), "hiding restarts");
