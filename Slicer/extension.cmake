@@ -40,6 +40,7 @@ if(CMAKE_CUDA_COMPILER)
   enable_language(CUDA)
 endif()
 add_subdirectory(${MMRTM_SOURCE_DIR}/cuda ${CMAKE_BINARY_DIR}/mmrtm-tracer)
+add_subdirectory(${MMRTM_SOURCE_DIR}/Labels ${CMAKE_BINARY_DIR}/mmrtm-labels)
 add_subdirectory(${MMRTM_SOURCE_DIR}/VTKModule ${CMAKE_BINARY_DIR}/mmrtm-vtk)
 
 #-----------------------------------------------------------------------------

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -24,6 +25,7 @@
 #include "denoised_display.h"
 #include "denoiser.h"
 #include "image_io.h"
+#include "label_materials.h"
 #include "mmrtmVolumeLoader.h"
 #include "render_backend.h"
 #include "scene_json.h"
@@ -508,14 +510,16 @@ int Run(const Options& o) {
   } else if (!o.series.empty()) {
     throw mmrtm::InputError("--series needs a DICOM folder as INPUT");
   }
+  std::optional<mmrtm::LabelTable> labelTable;
   if (!o.labelTable.empty()) {
     if (!doc.contains("label_materials"))
       std::fprintf(
           stderr,
           "warning: --label-table %s is not used: the scene has no \"label_materials\" (try --preset ct-organs)\n",
           o.labelTable.c_str());
-    inputs.labelTable = mmrtm::ReadLabelTable(o.labelTable);
+    labelTable = mmrtm::ReadLabelTable(o.labelTable);
   }
+  mmrtm::ExpandLabelMaterialsOnLoad(inputs, std::move(labelTable));
   if (!o.labels.empty()) {
     if (!o.quiet) std::fprintf(stderr, "Loading labels %s\n", o.labels.c_str());
     inputs.volumes["labels"] = WarnAboutNanVoxels(mmrtm::LoadVolume(o.labels, "labels", mmrtm::Interpolation::Nearest));

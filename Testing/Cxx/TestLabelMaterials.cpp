@@ -126,6 +126,60 @@ TEST(LabelMaterials, IdsPresentInAVolume) {
   EXPECT_THROW(LabelIdsPresent(v), InputError);
 }
 
+// The scene format's label classes reach the tracer's parser through the
+// labels library: with ExpandLabelMaterialsOnLoad a document's classes and
+// table name the materials of the labels present; without it the parser
+// refuses them by name (rather than rendering without the labels); a
+// --label-table takes the place of the document's table; a missing label
+// map is named. Catches the expansion lost on the way to SceneFromJson.
+TEST(LabelMaterials, TheSceneParserExpandsLabelClassesThroughTheLabelsLibrary) {
+  auto volume = [](const std::string& name, std::vector<uint16_t> values) {
+    HostVolume v;
+    v.name = name;
+    v.source = name;
+    v.dims = {int(values.size()), 1, 1};
+    v.type = VoxelType::UInt16;
+    v.voxels.assign(reinterpret_cast<const uint8_t*>(values.data()),
+                    reinterpret_cast<const uint8_t*>(values.data() + values.size()));
+    return v;
+  };
+  const LabelTable table = Table();
+  json doc = json::parse(R"({"materials": {"tissue": {"density": 1}},
+    "label_materials": {"classes": [{"match": ["*"], "material": {"density": 2}}]}})");
+  doc["label_table"] = table.source;
+  auto inputs = [&](bool labels) {
+    SceneInputs in;
+    in.volumes["scalars"] = volume("scalars", {10, 20, 30, 40});
+    if (labels) in.volumes["labels"] = volume("labels", {0, 1, 2, 1});
+    return in;
+  };
+  try {
+    SceneFromJson(doc, inputs(true));
+    FAIL() << "label classes were parsed without the labels library";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("label_materials"), std::string::npos) << e.what();
+  }
+  SceneInputs in = inputs(true);
+  ExpandLabelMaterialsOnLoad(in);
+  const Scene scene = SceneFromJson(doc, std::move(in));
+  EXPECT_GE(scene.MaterialIndex("aorta"), 0);
+  EXPECT_GE(scene.MaterialIndex("vertebrae_T12"), 0);
+  EXPECT_LT(scene.MaterialIndex("liver"), 0);  // not present in the label map
+  LabelTable other;
+  other.entries.push_back({1, "renamed", DefaultLabelColor(1), 1.f, false});
+  in = inputs(true);
+  ExpandLabelMaterialsOnLoad(in, other);
+  EXPECT_GE(SceneFromJson(doc, std::move(in)).MaterialIndex("renamed"), 0);
+  in = inputs(false);
+  ExpandLabelMaterialsOnLoad(in);
+  try {
+    SceneFromJson(doc, std::move(in));
+    FAIL() << "label classes without a label map were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("label_materials.proxy"), std::string::npos) << e.what();
+  }
+}
+
 // The one label rule (Slicer's segments, the viewer's label list): density
 // 2.5/mm times the opacity, none when hidden, the colour as albedo, the
 // surface parameters kept. Catches another density rule or an opacity that

@@ -17,6 +17,7 @@
 #include "FuzzScratch.h"
 #include "cpu_renderer.h"
 #include "film.h"
+#include "label_materials.h"
 #include "scene_json.h"
 
 namespace {
@@ -52,6 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // As mmrtm-render's INPUT and --labels: presets name these without files.
     inputs.volumes["scalars"] = SyntheticVolume("input.nrrd", "scalars", mmrtm::Interpolation::Trilinear);
     inputs.volumes["labels"] = SyntheticVolume("labels.nrrd", "labels", mmrtm::Interpolation::Nearest);
+    mmrtm::ExpandLabelMaterialsOnLoad(inputs);  // as mmrtm-render: the label classes too
     mmrtm::Scene scene = mmrtm::SceneFromJson(mmrtm::ReadJsonFile(path), inputs);
     // Built as mmrtm-render builds it (one grid thread): Build validates the
     // settings (spp 0 is refused there, not by the parser).

@@ -1,502 +1,40 @@
 #include "vtkMultiMaterialVolumeMapper.h"
+#include "vtkMultiMaterialVolumeMapperInternals.h"
 
 #include <algorithm>
-#include <array>
-#include <cfloat>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <map>
-#include <optional>
-#include <string>
-#include <thread>
-#include <tuple>
-#include <vector>
 
 #include <vtkCallbackCommand.h>
-#include <vtkCamera.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
-#include <vtkDemandDrivenPipeline.h>
 #include <vtkFloatArray.h>
 #include <vtkIdList.h>
-#include <vtkNew.h>
-#include <vtkColorTransferFunction.h>
-#include <vtkContourValues.h>
-#include <vtkImageData.h>
 #include <vtkInformation.h>
 #include <vtkInformationObjectBaseVectorKey.h>
-#include <vtkLight.h>
-#include <vtkLightCollection.h>
-#include <vtkMatrix4x4.h>
-#include <vtkObjectFactory.h>
 #include <vtkOpenGLFramebufferObject.h>
 #include <vtkOpenGLRenderPass.h>
 #include <vtkOpenGLRenderWindow.h>
 #include <vtkOpenGLState.h>
-#include <vtkPiecewiseFunction.h>
 #include <vtkPlane.h>
 #include <vtkPlaneCollection.h>
-#include <vtkRayCastImageDisplayHelper.h>
+#include <vtkPointData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
-#include <vtkPointData.h>
-#include <vtkRectilinearGrid.h>
-#include <vtkTexture.h>
-#include <vtkTimeStamp.h>
-#include <vtkSmartPointer.h>
 #include <vtkVolume.h>
-#include <vtkVolumeProperty.h>
-#include <vtkWeakPointer.h>
 #if __has_include(<vtk_glad.h>)
 #include <vtk_glad.h> // VTK 9.4 and later: the GL enums
 #else
 #include <vtk_glew.h>
 #endif
 
-#include "denoised_display.h"
-#include "denoiser.h"
-#include "derived_proxies.h"
-#include "film.h"
-#include "label_alignment.h"
-#include "label_materials.h"
 #include "mmrtmImageDataConversion.h"
-#include "mmrtmTracedImage.h"
-#include "mmrtmVolumePropertyFunctions.h"
-#include "mmrtmVtkSceneTranslation.h"
-#include "mmrtm/planted_defect.h"
-#include "render_backend.h"
-#include "scene.h"
-#include "scene_json.h"
-#include "vtkMultiMaterialProperty.h"
 
 vtkStandardNewMacro(vtkMultiMaterialVolumeMapper);
 
-// What a render reads, in three parts, each of which decides one phase's
-// work: the proxies (voxels, mask, the components the property uses), the
-// materials (the property, the multi-material description, the label
-// parameters) and the view (camera, lights, viewport, clipping, opaque
-// geometry, environment, the mapper's tracing settings). Modification
-// times where VTK keeps them; the view by value (SameView).
-struct vtkMultiMaterialVolumeMapper::InputState
-{
-  struct ProxyInputs
-  {
-    vtkImageData* Data = nullptr;
-    vtkMTimeType DataTime = 0;
-    vtkDataArray* Scalars = nullptr; // the array the mapper's scalar mode picks
-    vtkImageData* Mask = nullptr;
-    vtkMTimeType MaskTime = 0;
-    int MaskType = -1;
-    vtkMultiMaterialProperty* MultiMaterial = nullptr;
-    int Dependent = -1;          // components used as colour + opacity (IndependentComponents off)
-    int Independent = -1;        // components mixed additively (IndependentComponents on)
-    int ComponentGradients = -1; // independent components with gradient opacity (bit c)
-    bool NeedGradient = false;   // a gradient-magnitude proxy (without a description)
-    bool operator==(const ProxyInputs& o) const
-    {
-      return std::tie(this->Data, this->DataTime, this->Scalars, this->Mask, this->MaskTime, this->MaskType,
-               this->MultiMaterial, this->Dependent, this->Independent, this->ComponentGradients, this->NeedGradient) ==
-        std::tie(o.Data, o.DataTime, o.Scalars, o.Mask, o.MaskTime, o.MaskType, o.MultiMaterial, o.Dependent,
-          o.Independent, o.ComponentGradients, o.NeedGradient);
-    }
-  } Proxies;
-
-  struct MaterialInputs
-  {
-    vtkVolumeProperty* Property = nullptr;
-    vtkMTimeType PropertyTime = 0, MultiMaterialTime = 0, LabelMaterialsTime = 0;
-    mmrtm::TranslationOptions Options; // the mapper's: unshaded scattering, isosurfaces
-  } Materials;
-
-  struct ViewInputs
-  {
-    int Width = 0, Height = 0;         // the viewport's
-    int FilmWidth = 0, FilmHeight = 0; // the still film's: the viewport's over the image sample distance
-    std::vector<double> Values;        // camera, lights, matrix, size, clipping, environment: SameView
-    std::vector<mmrtm::ClipPlane> Clip;
-    std::vector<float> Depth; // the depth buffer under the volume
-    vtkMTimeType TracingTime = 0;
-    // Which view of the mapper's this is: a renderer and volume (one
-    // mapper may serve several), and whether it is a tile of a magnified
-    // image (vtkWindowToImageFilter::SetScale, vtkRenderLargeImage).
-    vtkRenderer* Renderer = nullptr;
-    vtkVolume* Volume = nullptr;
-    bool Tile = false;
-  } View;
-};
-
-// Which phases a render must run: the answer of ChangesSince.
-struct vtkMultiMaterialVolumeMapper::Changes
-{
-  bool Proxies = false;     // made again from the input (and the description parsed over them)
-  bool Description = false; // the description parsed again over the proxies as they are
-  bool Materials = false;   // the property translated again
-  bool View = false;        // the camera, lights and settings set again
-  bool Any() const { return this->Proxies || this->Description || this->Materials || this->View; }
-};
-
-// What the mapper keeps between renders, and the inputs it was made from.
-struct vtkMultiMaterialVolumeMapper::Internals
-{
-  mmrtm::Scene Scene;
-  std::unique_ptr<mmrtm::Renderer> Renderer;
-  int RendererBackend = -1, RendererThreads = -1;
-  std::unique_ptr<mmrtm::Film> Film;
-  std::string BackendDescription;
-  vtkNew<vtkMatrix4x4> Matrix; // the volume's matrix at the last render
-  // Draws the image as a texture: the OpenGL helper, from the object factory
-  // at the first draw (RenderingVolumeOpenGL2 must be loaded by then).
-  vtkSmartPointer<vtkRayCastImageDisplayHelper> DisplayHelper;
-
-  // Index-to-world of each proxy before the volume's matrix.
-  std::vector<mmrtm::Affine3> ImageIndexToWorld;
-  mmrtm::ProxyLayout Layout;
-  vtkSmartPointer<vtkImageData> Mask;
-  vtkSmartPointer<vtkMultiMaterialProperty> MultiMaterial;
-  bool LightsFromScene = false; // the multi-material description has its own lights
-  vtkSmartPointer<vtkTexture> EnvironmentTexture;
-  std::shared_ptr<mmrtm::EnvironmentMap> Environment; // converted from the texture
-  vtkMTimeType EnvironmentTime = 0;
-  double EnvironmentScale = 0;
-  // SetLabelMaterial and SetLabelMaterialParameters, by label.
-  std::map<int, mmrtm::LabelLook> LabelLooks;
-  std::map<int, std::string> LabelMaterialParameters;
-  // When they last changed as values: labels removed and set again to the
-  // looks they had (a front end that sets all its labels at each update)
-  // are no change.
-  vtkMTimeType LabelMaterialsTime()
-  {
-    if (this->LabelLooks != this->LabelLooksSeen || this->LabelMaterialParameters != this->LabelParametersSeen)
-    {
-      this->LabelLooksSeen = this->LabelLooks;
-      this->LabelParametersSeen = this->LabelMaterialParameters;
-      this->LabelMaterialsChanged.Modified();
-    }
-    return this->LabelMaterialsChanged.GetMTime();
-  }
-  std::map<int, mmrtm::LabelLook> LabelLooksSeen;
-  std::map<int, std::string> LabelParametersSeen;
-  vtkTimeStamp LabelMaterialsChanged;
-  // The looks with their parameters (a description's label classes).
-  std::map<int, mmrtm::LabelLook> LabelLooksWithParameters() const
-  {
-    std::map<int, mmrtm::LabelLook> looks = this->LabelLooks;
-    for (auto& [label, look] : looks)
-      if (const auto found = this->LabelMaterialParameters.find(label); found != this->LabelMaterialParameters.end())
-      {
-        look.surface = mmrtm::ParseJson(found->second, "label " + std::to_string(label) + " material");
-        if (!look.surface.is_object())
-          throw mmrtm::InputError("label " + std::to_string(label) + " material: expected a JSON object");
-      }
-    return looks;
-  }
-  // The inputs as the scene and the film were last made from them; each
-  // render compares what it finds with these (ChangesSince).
-  InputState Built;
-  // The accumulation of the view before, while another is drawn: the whole
-  // view during the tiles of a magnified screenshot, or another renderer's
-  // or volume's view of this mapper. The film goes on when its view comes
-  // back (TakeFilm); a change of the scene drops it.
-  std::unique_ptr<mmrtm::Film> ParkedFilm;
-  InputState::ViewInputs ParkedView;
-  bool HasScene = false; // false until a build succeeds, and after a failed one
-
-  // Whether each warning's cause held when it was last checked: a warning
-  // is said when its cause appears, and again only after the cause went
-  // away and came back (each its own flag: one shared flag silenced the
-  // others after the first).
-  std::map<std::string, bool> WarningCauses;
-  bool Warn(const std::string& warning, bool cause)
-  {
-    bool& held = this->WarningCauses[warning];
-    const bool say = cause && !held;
-    held = cause;
-    return say;
-  }
-
-  // The last input converted for the tracer (ReadTracedImage), with what
-  // it was converted from.
-  struct Conversion
-  {
-    vtkDataSet* Input = nullptr;
-    vtkMTimeType InputTime = 0;
-    vtkDataArray* Scalars = nullptr;
-    vtkMTimeType ScalarsTime = 0;
-    bool Cell = false;
-    mmrtm::TracedImage Traced;
-  } Converted;
-
-  // Asynchronous refinement: the pass in flight adds samples to Film on a
-  // thread of its own while renders draw Shown (Film as of the last pass
-  // that finished). A pass starts only when nothing changed, so it runs
-  // under Built: a render that finds any change stops it (between tiles)
-  // first.
-  struct Pass
-  {
-    std::thread Thread;
-    std::atomic<bool> Cancel{ false }, Done{ false }, Completed{ false };
-    std::string Error;
-    bool Denoising = false; // a denoise of Shown, not samples
-    std::optional<mmrtm::DenoisedFilm> Denoised;
-  };
-  std::unique_ptr<Pass> InFlight;
-  std::unique_ptr<mmrtm::Film> Shown;
-
-  // The denoised display (DenoisingMode): what the frames show of the
-  // film. FilmGeneration numbers the film's accumulations (a restart or a
-  // reset starts a new one), so that a denoise of one is never shown over
-  // another.
-  mmrtm::DenoisedDisplay Display;
-  uint64_t FilmGeneration = 0;
-  std::unique_ptr<mmrtm::Denoiser> Denoiser; // loaded at the first need
-  bool DenoiserLoadTried = false;
-  std::optional<mmrtm::DenoisedFilm> PreviewDenoised; // the interactive preview, when denoised
-  uint64_t PreviewStandsFor = 0;                      // the accumulation it stands for (RenderFrame), or 0
-  double PreviewDenoiseSeconds = 0;
-  int PreviewDenoises = 0;
-  // What the last frame drew: the mapper's film (or the copy of it that
-  // asynchronous refinement draws), a preview, or another film (combined
-  // from other processes); how many samples it had; whether denoised.
-  enum class ShownImage
-  {
-    Nothing,
-    Film,
-    Preview,
-    Other
-  } LastShown = ShownImage::Nothing;
-  uint32_t LastShownSamples = 0;
-  bool ShowedDenoised = false;
-  std::string DisplayStatus; // GetDisplayStatus's
-
-  // What GetTracingMTime last found (TracingInputs), and when it changed.
-  std::vector<double> TracingInputsSeen;
-  vtkTimeStamp TracingInputsTime;
-
-  int SceneBuilds = 0, Refits = 0, Restarts = 0, InteractiveRenders = 0, GridBuilds = 0, GridRefits = 0;
-  // After a Scene.Build: what it did to the majorant grid.
-  void CountGridWork()
-  {
-    this->GridBuilds += this->Scene.GridSummariesBuiltByLastBuild() ? 1 : 0;
-    this->GridRefits += this->Scene.GridRefittedByLastBuild() ? 1 : 0;
-  }
-  std::string LastExtinctionWarning; // said once per change (vtkWarningMacro)
-  double LastBuildSeconds = 0;
-  // While the interactor moves the camera: a preview with an image sample
-  // distance of PreviewDistance (1/PreviewDistance of the resolution), 1
-  // sample per pixel, the distance adapted to the volume's allocated time.
-  std::unique_ptr<mmrtm::Film> Preview;
-  double PreviewDistance = 4.0;
-  int TracedPasses = 0;
-  int LastFilmSize[2] = { 0, 0 };
-
-  // Depth peeling for volumes calls Render once per peel: each renderer's
-  // StartEvent marks a new frame (Traced false), and the first call of a
-  // frame traces and draws it.
-  struct PeelFrame
-  {
-    vtkWeakPointer<vtkRenderer> Renderer;
-    unsigned long Observer = 0;
-    bool Traced = false;
-  };
-  std::vector<std::unique_ptr<PeelFrame>> PeelFrames;
-};
-
 namespace
 {
-// Global illumination off: the shadow rays' extinction scale. The tracer
-// takes a scale above 0; at this one a shadow ray through the densest
-// tissue the translation makes (an optical depth of 64 per voxel) over
-// 1000 voxels transmits 0.94, everything lighter nearly 1.
-constexpr float kLocalLightingShadowScale = 1e-6f;
-
-// The property's modification time without the edits of its colour
-// functions: what the planted defect MapperColorRefit sees.
-vtkMTimeType MTimeWithoutColours(vtkVolumeProperty* p)
-{
-  vtkMTimeType t = p->vtkObject::GetMTime();
-  for (int c = 0; c < VTK_MAX_VRCOMP; ++c)
-    for (vtkPiecewiseFunction* f : { mmrtm::HeldScalarOpacity(p, c), mmrtm::HeldGradientOpacity(p, c) })
-      if (f)
-        t = std::max(t, f->GetMTime());
-  return t;
-}
-
-// The latest modification among the property and its functions.
-// vtkVolumeProperty::GetMTime counts the component functions it holds and
-// when label functions were set; a label function edited in place is
-// counted here. Nothing is created in the property (its getters would).
-vtkMTimeType PropertyMTime(vtkVolumeProperty* p)
-{
-  const bool missColours = mmrtm::Planted(mmrtm::Defect::MapperColorRefit);
-  vtkMTimeType t = missColours ? MTimeWithoutColours(p) : p->GetMTime();
-  if (vtkImageData* table = p->GetTransferFunction2D(0))
-    t = std::max(t, table->GetMTime());
-  for (const vtkTimeStamp& set :
-    { p->GetLabelColorMTime(), p->GetLabelScalarOpacityMTime(), p->GetLabelGradientOpacityMTime() })
-    t = std::max(t, set.GetMTime());
-  for (int label : p->GetLabelMapLabels())
-  {
-    if (vtkPiecewiseFunction* f = p->GetLabelScalarOpacity(label))
-      t = std::max(t, f->GetMTime());
-    if (vtkPiecewiseFunction* f = p->GetLabelGradientOpacity(label))
-      t = std::max(t, f->GetMTime());
-    if (vtkColorTransferFunction* f = p->GetLabelColor(label))
-      t = std::max(t, missColours ? 0 : f->GetMTime());
-  }
-  return t;
-}
-
-// Camera, lights, the volume's matrix and the viewport, as values: a change
-// restarts the accumulation. Values rather than modification times, because
-// VTK swaps in near copies (vtkWindowToImageFilter renders with a copy of
-// the camera whose view angle is off by 1e-8): a screenshot must not restart.
-std::vector<double> ViewSignature(vtkRenderer* ren, vtkVolume* vol, int width, int height)
-{
-  std::vector<double> v{ static_cast<double>(width), static_cast<double>(height) };
-  auto add = [&v](const double* p, int n) { v.insert(v.end(), p, p + n); };
-  vtkCamera* cam = ren->GetActiveCamera();
-  add(cam->GetPosition(), 3);
-  add(cam->GetFocalPoint(), 3);
-  add(cam->GetViewUp(), 3);
-  add(cam->GetWindowCenter(), 2);
-  v.push_back(cam->GetViewAngle());
-  v.push_back(cam->GetParallelProjection());
-  v.push_back(cam->GetParallelScale());
-  vtkNew<vtkMatrix4x4> m;
-  vol->GetMatrix(m);
-  add(&m->Element[0][0], 16);
-  vtkLightCollection* lights = ren->GetLights();
-  lights->InitTraversal();
-  while (vtkLight* l = lights->GetNextItem())
-  {
-    double p[3], f[3];
-    l->GetTransformedPosition(p);
-    l->GetTransformedFocalPoint(f);
-    add(p, 3);
-    add(f, 3);
-    add(l->GetDiffuseColor(), 3);
-    v.push_back(l->GetIntensity());
-    v.push_back(l->GetSwitch());
-    v.push_back(l->GetPositional());
-  }
-  return v;
-}
-
-// Equal to a relative 1e-6: vtkWindowToImageFilter renders with a camera
-// whose view angle went through tan and atan.
-bool SameView(const std::vector<double>& a, const std::vector<double>& b)
-{
-  if (a.size() != b.size())
-    return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    if (std::abs(a[i] - b[i]) > 1e-6 * std::max({ 1.0, std::abs(a[i]), std::abs(b[i]) }))
-      return false;
-  return true;
-}
-
-// The depth buffer of the viewport (opaque geometry drawn before volumes),
-// window depth in [0, 1], rows bottom first; empty without any geometry.
-std::vector<float> ReadDepth(vtkRenderer* ren, int width, int height, int x0, int y0)
-{
-  std::vector<float> depth(static_cast<size_t>(width) * height, 1.f);
-  ren->GetRenderWindow()->GetZbufferData(x0, y0, x0 + width - 1, y0 + height - 1, depth.data());
-  for (float z : depth)
-    if (z < 1.f)
-      return depth;
-  return {};
-}
-
-// Pixels of a film over `size` viewport pixels at an image sample distance.
-int FilmSize(int size, double distance)
-{
-  return std::max(1, static_cast<int>(std::ceil(size / distance - 1e-9)));
-}
-
-// The viewport's depth buffer (width x height) at the pixel centres of a
-// film of w x h stretched over it.
-std::vector<float> DepthAtFilmPixels(const std::vector<float>& depth, int width, int height, int w, int h)
-{
-  if (w == width && h == height)
-    return depth;
-  std::vector<float> at(static_cast<size_t>(w) * h);
-  for (int row = 0; row < h; ++row)
-    for (int x = 0; x < w; ++x)
-    {
-      const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / w));
-      const int fy = std::min(height - 1, static_cast<int>((row + 0.5) * height / h));
-      at[static_cast<size_t>(row) * w + x] = depth[static_cast<size_t>(fy) * width + fx];
-    }
-  return at;
-}
-
-// Per pixel (rows top first, as the film): the distance along the camera
-// ray to the geometry in the depth buffer, kInfinity where there is none.
-// Perspective rays start at the camera, orthographic ones in the plane
-// through it.
-std::vector<float> CameraRayMaxDistance(vtkRenderer* ren, const std::vector<float>& depth, int width, int height)
-{
-  vtkCamera* camera = ren->GetActiveCamera();
-  vtkNew<vtkMatrix4x4> inverse;
-  inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(ren->GetTiledAspectRatio(), -1, 1));
-  inverse->Invert();
-  const double* eye = camera->GetPosition();
-  double dir[3];
-  camera->GetDirectionOfProjection(dir);
-  const bool parallel = camera->GetParallelProjection() != 0;
-  std::vector<float> t(depth.size(), mmrtm::kInfinity);
-  for (int row = 0; row < height; ++row)
-    for (int x = 0; x < width; ++x)
-    {
-      const float z = depth[static_cast<size_t>(row) * width + x];
-      if (z >= 1.f)
-        continue;
-      const double ndc[4] = { 2.0 * (x + 0.5) / width - 1.0, 2.0 * (row + 0.5) / height - 1.0, 2.0 * z - 1.0, 1.0 };
-      double p[4];
-      inverse->MultiplyPoint(ndc, p);
-      double d[3], len2 = 0, along = 0;
-      for (int k = 0; k < 3; ++k)
-      {
-        d[k] = p[k] / p[3] - eye[k];
-        len2 += d[k] * d[k];
-        along += d[k] * dir[k];
-      }
-      t[static_cast<size_t>(height - 1 - row) * width + x] = static_cast<float>(parallel ? along : std::sqrt(len2));
-    }
-  return t;
-}
-
-mmrtm::Affine3 ToAffine(vtkMatrix4x4* m)
-{
-  mmrtm::Affine3 a;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c)
-      a.m[r][c] = static_cast<float>(m->GetElement(r, c));
-  return a;
-}
-
-// The cropping regions of any flags but the subvolume's (ClipPlanes clips
-// that one exactly), tested per point in the data's coordinates.
-mmrtm::Scene::Cropping CroppingRegions(vtkVolumeMapper* mapper, vtkVolume* vol)
-{
-  mmrtm::Scene::Cropping cropping;
-  if (!mapper->GetCropping() || mapper->GetCroppingRegionFlags() == VTK_CROP_SUBVOLUME)
-    return cropping;
-  vtkNew<vtkMatrix4x4> inverse;
-  vol->GetMatrix(inverse);
-  inverse->Invert();
-  cropping.worldToData = ToAffine(inverse);
-  cropping.keep = static_cast<uint32_t>(mapper->GetCroppingRegionFlags()) & mmrtm::Classifier::kNoCropping;
-  const double* planes = mapper->GetCroppingRegionPlanes();
-  for (int a = 0; a < 3; ++a)
-  {
-    cropping.lo[a] = static_cast<float>(planes[2 * a]);
-    cropping.hi[a] = static_cast<float>(planes[2 * a + 1]);
-  }
-  return cropping;
-}
-
 // Equal to the bit, NaN to NaN: a setting set again to its value is no change.
 bool SameValues(const std::vector<double>& a, const std::vector<double>& b)
 {
@@ -542,54 +80,16 @@ std::vector<double> TracingInputs(vtkMultiMaterialVolumeMapper* m, std::initiali
 }
 
 vtkMultiMaterialVolumeMapper::vtkMultiMaterialVolumeMapper()
-  : Internal(new Internals)
+  : Internal(new Internals(this))
 {
 }
 
 vtkMultiMaterialVolumeMapper::~vtkMultiMaterialVolumeMapper()
 {
-  this->FinishPass(true);
+  this->Internal->FinishPass(true);
   for (const auto& frame : this->Internal->PeelFrames)
     if (vtkRenderer* ren = frame->Renderer)
       ren->RemoveObserver(frame->Observer);
-}
-
-void vtkMultiMaterialVolumeMapper::FinishPass(bool cancel)
-{
-  Internals& in = *this->Internal;
-  if (!in.InFlight)
-    return;
-  if (cancel)
-    in.InFlight->Cancel = true;
-  in.InFlight->Thread.join();
-  if (!in.InFlight->Error.empty())
-    vtkErrorMacro("Render: " << in.InFlight->Error);
-  if (in.InFlight->Denoising)
-    in.Display.Finished(std::move(in.InFlight->Denoised)); // the film is untouched
-  else if (in.InFlight->Completed)
-    in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
-  else
-    in.Film.reset(); // a partial pass: the next render restarts
-  in.InFlight.reset();
-}
-
-// Whether bringing the input up to date will run its producer (the test
-// vtkDemandDrivenPipeline makes: data older than the pipeline's MTime).
-bool vtkMultiMaterialVolumeMapper::InputWillExecute()
-{
-  vtkAlgorithm* producer = this->GetInputAlgorithm();
-  vtkDataObject* data = this->GetInputDataObject(0, 0);
-  auto* executive = producer ? vtkDemandDrivenPipeline::SafeDownCast(producer->GetExecutive()) : nullptr;
-  if (!executive || !data)
-    return true;
-  executive->UpdatePipelineMTime();
-  return data->GetUpdateTime() < executive->GetPipelineMTime();
-}
-
-const mmrtm::Film* vtkMultiMaterialVolumeMapper::ImageFilm()
-{
-  Internals& in = *this->Internal;
-  return in.InFlight ? in.Shown.get() : in.Film.get();
 }
 
 bool vtkMultiMaterialVolumeMapper::IsRefining()
@@ -599,7 +99,7 @@ bool vtkMultiMaterialVolumeMapper::IsRefining()
 
 void vtkMultiMaterialVolumeMapper::ResetAccumulation()
 {
-  this->FinishPass(true);
+  this->Internal->FinishPass(true);
   if (this->Internal->Film)
     this->Internal->Film->Reset();
   ++this->Internal->FilmGeneration;
@@ -689,7 +189,7 @@ vtkImageData* vtkMultiMaterialVolumeMapper::GetMaskInput()
 
 int vtkMultiMaterialVolumeMapper::GetAccumulatedSamples()
 {
-  const mmrtm::Film* film = this->ImageFilm();
+  const mmrtm::Film* film = this->Internal->ImageFilm();
   return film ? static_cast<int>(film->Samples()) : 0;
 }
 
@@ -766,33 +266,19 @@ void vtkMultiMaterialVolumeMapper::RemoveAllLabelMaterialParameters()
 
 double vtkMultiMaterialVolumeMapper::GetRelativeNoise()
 {
-  const mmrtm::Film* film = this->ImageFilm();
+  const mmrtm::Film* film = this->Internal->ImageFilm();
   return film && film->Samples() >= 2 ? film->Noise().relative : 0.0;
 }
 
 bool vtkMultiMaterialVolumeMapper::IsConverged()
 {
-  const mmrtm::Film* film = this->ImageFilm();
-  if (!this->FilmConverged())
+  const mmrtm::Film* film = this->Internal->ImageFilm();
+  if (!this->Internal->FilmConverged())
     return false;
   // The image shown is final once no denoise is running or due.
   Internals& in = *this->Internal;
   return !(in.InFlight && in.InFlight->Denoising) &&
-    !(this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, film->Samples(), false));
-}
-
-bool vtkMultiMaterialVolumeMapper::FilmConverged()
-{
-  const mmrtm::Film* film = this->ImageFilm();
-  if (!film)
-    return false;
-  const int accumulated = static_cast<int>(film->Samples());
-  if (this->MaximumSamples > 0 && accumulated >= this->MaximumSamples)
-    return true;
-  if (accumulated >= 1 && this->Internal->Scene.render.integrator.projection.mode != mmrtm::IntensityProjection::None)
-    return true; // a projection's one sample is its image
-  // The noise estimate needs two samples; it costs one pass over the film.
-  return this->NoiseTarget > 0 && accumulated >= 2 && film->Noise().relative <= this->NoiseTarget;
+    !(this->Internal->DenoisingApplies() && in.Display.Due(in.FilmGeneration, film->Samples(), false));
 }
 
 void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
@@ -800,7 +286,7 @@ void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
   if (!image)
     return;
   image->Initialize();
-  const mmrtm::Film* film = this->ImageFilm();
+  const mmrtm::Film* film = this->Internal->ImageFilm();
   if (!film || film->Samples() == 0)
     return;
   const int width = film->Width(), height = film->Height();
@@ -825,7 +311,7 @@ void vtkMultiMaterialVolumeMapper::GetAccumulatedImage(vtkImageData* image)
 const char* vtkMultiMaterialVolumeMapper::GetDisplayStatus()
 {
   Internals& in = *this->Internal;
-  const mmrtm::Film* film = this->ImageFilm();
+  const mmrtm::Film* film = this->Internal->ImageFilm();
   switch (in.LastShown)
   {
     case Internals::ShownImage::Nothing:
@@ -854,11 +340,11 @@ void vtkMultiMaterialVolumeMapper::GetDisplayedImage(vtkImageData* image)
 {
   // What a frame drawn now would show of the film (previews are not kept).
   Internals& in = *this->Internal;
-  const mmrtm::Film* film = this->ImageFilm();
+  const mmrtm::Film* film = this->Internal->ImageFilm();
   if (film)
     in.Display.Recheck(*film, in.FilmGeneration);
   const mmrtm::DenoisedFilm* denoised =
-    film && this->DenoisingApplies() ? in.Display.Shown(in.FilmGeneration, film->Samples()) : nullptr;
+    film && this->Internal->DenoisingApplies() ? in.Display.Shown(in.FilmGeneration, film->Samples()) : nullptr;
   if (!denoised)
   {
     this->GetAccumulatedImage(image);
@@ -1029,8 +515,8 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->InvokeEvent(vtkCommand::VolumeMapperRenderStartEvent, nullptr);
   auto* window = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   if (!InDualDepthPeeling(vol) || !window || !window->GetRenderFramebuffer())
-    this->RenderFrame(ren, vol);
-  else if (this->TracesInThisFrame(ren))
+    this->Internal->RenderFrame(ren, vol);
+  else if (this->Internal->TracesInThisFrame(ren))
   {
     // The peels' shaders split a ray into depth ranges between translucent
     // layers; the film has no such layers. It is traced once and drawn into
@@ -1047,7 +533,7 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     {
       vtkOpenGLState::ScopedglEnableDisable cull(state, GL_CULL_FACE);
       state->vtkglDisable(GL_CULL_FACE);
-      this->RenderFrame(ren, vol);
+      this->Internal->RenderFrame(ren, vol);
     }
     state->vtkglBlendEquation(static_cast<unsigned int>(equation));
     state->PopFramebufferBindings();
@@ -1056,9 +542,9 @@ void vtkMultiMaterialVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->InvokeEvent(vtkCommand::VolumeMapperRenderEndEvent, nullptr);
 }
 
-bool vtkMultiMaterialVolumeMapper::TracesInThisFrame(vtkRenderer* ren)
+bool vtkMultiMaterialVolumeMapper::Internals::TracesInThisFrame(vtkRenderer* ren)
 {
-  Internals& in = *this->Internal;
+  Internals& in = *this;
   Internals::PeelFrame* frame = nullptr;
   for (const auto& f : in.PeelFrames)
     if (f->Renderer == ren)
@@ -1080,15 +566,15 @@ bool vtkMultiMaterialVolumeMapper::TracesInThisFrame(vtkRenderer* ren)
 }
 
 // The phases of one frame's image, drawn into the bound framebuffer.
-void vtkMultiMaterialVolumeMapper::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
+void vtkMultiMaterialVolumeMapper::Internals::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
 {
-  Internals& in = *this->Internal;
+  Internals& in = *this;
   const auto start = std::chrono::steady_clock::now();
   auto draw = [&](const mmrtm::Film& film)
   {
     in.LastFilmSize[0] = film.Width();
     in.LastFilmSize[1] = film.Height();
-    this->DrawFilm(ren, vol, film);
+    Self->DrawFilm(ren, vol, film);
   };
   int viewport[4] = { 0, 0, 0, 0 }; // width, height, origin x, origin y
   if (!this->ValidateInputs(ren, vol, viewport))
@@ -1105,7 +591,7 @@ void vtkMultiMaterialVolumeMapper::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
     // Asynchronous refinement: a pass in flight goes on while nothing
     // changed (the last finished image is drawn); else it is stopped.
     vtkRenderWindow* window = ren->GetRenderWindow();
-    const bool interactive = this->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0;
+    const bool interactive = Self->InteractiveAdjustResolution && window->GetDesiredUpdateRate() > 1.0;
     if (in.InFlight)
     {
       if (!in.InFlight->Done && !interactive && !changes.Any())
@@ -1157,804 +643,8 @@ void vtkMultiMaterialVolumeMapper::RenderFrame(vtkRenderer* ren, vtkVolume* vol)
   }
   catch (const std::exception& e)
   {
-    vtkErrorMacro("Render: " << e.what());
+    vtkErrorWithObjectMacro(Self, "Render: " << e.what());
   }
-}
-
-bool vtkMultiMaterialVolumeMapper::ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4])
-{
-  Internals& in = *this->Internal;
-  if (!this->GetInput() || !vol->GetProperty())
-  {
-    vtkErrorMacro("Render: " << (this->GetInput() ? "the vtkVolume has no volume property" : "no input"));
-    return false;
-  }
-  ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
-  return viewport[0] > 0 && viewport[1] > 0;
-}
-
-vtkMultiMaterialVolumeMapper::InputState vtkMultiMaterialVolumeMapper::ReadInputs(
-  vtkRenderer* ren, vtkVolume* vol, const int viewport[4])
-{
-  Internals& in = *this->Internal;
-  InputState now;
-  // The input brought up to date (a new or modified input rebuilds).
-  this->GetInputAlgorithm()->UpdateInformation();
-  this->GetInputAlgorithm()->Update();
-  this->ReadTracedImage(now);
-  now.Proxies.Mask = in.Mask;
-  now.Proxies.MaskTime = in.Mask ? in.Mask->GetMTime() : 0;
-  now.Proxies.MaskType = this->MaskType;
-  now.Proxies.MultiMaterial = in.MultiMaterial;
-
-  // The proxies the property asks for.
-  vtkVolumeProperty* property = vol->GetProperty();
-  const int components = now.Proxies.Scalars->GetNumberOfComponents();
-  const bool independent = property->GetIndependentComponents() != 0;
-  now.Proxies.Dependent = !independent && (components == 2 || components == 4) ? components : 0;
-  now.Proxies.Independent = independent && components > 1 ? std::min(components, 4) : 0;
-  // 4 dependent components fill the 4 proxies: no room for a gradient.
-  const bool labels = in.Mask && this->MaskType == LABELMAP;
-  // Isosurfaces of one component (the others render as composite).
-  const bool isosurface = this->BlendMode == vtkVolumeMapper::ISOSURFACE_BLEND && !in.MultiMaterial;
-  const bool isosurfaceComponents = isosurface && (now.Proxies.Dependent || now.Proxies.Independent);
-  if (in.Warn("isosurface with components", isosurfaceComponents))
-    vtkWarningMacro("isosurface blending of " << components << " components is not supported; rendering as composite");
-  now.Materials.Options.isosurface = isosurface && !isosurfaceComponents;
-  if (now.Materials.Options.isosurface)
-  {
-    vtkContourValues* values = property->GetIsoSurfaceValues();
-    for (int i = 0; i < values->GetNumberOfContours(); ++i)
-      now.Materials.Options.isoValues.push_back(values->GetValue(i));
-    // VTK's GPU mapper composites an iso-value's opacity once per crossing,
-    // corrected from the unit distance to its sample distance: the
-    // smallest voxel spacing, or SampleDistance when the distances do not
-    // adapt.
-    const double* spacing = now.Proxies.Data->GetSpacing();
-    now.Materials.Options.isoSampleDistance = !this->AutoAdjustSampleDistances && this->SampleDistance > 0.f
-      ? this->SampleDistance
-      : static_cast<float>(std::min({ std::abs(spacing[0]), std::abs(spacing[1]), std::abs(spacing[2]) }));
-  }
-  // The projections show the colour they read as the albedo.
-  const bool projection = this->BlendMode == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND ||
-    this->BlendMode == vtkVolumeMapper::MINIMUM_INTENSITY_BLEND ||
-    this->BlendMode == vtkVolumeMapper::AVERAGE_INTENSITY_BLEND || this->BlendMode == vtkVolumeMapper::ADDITIVE_BLEND;
-  now.Materials.Options.unshadedScatters = this->UnshadedScattering || projection;
-  now.Materials.Options.localLighting = !this->GlobalIllumination;
-  now.Proxies.NeedGradient = !in.MultiMaterial && now.Proxies.Dependent != 4 && !now.Proxies.Independent &&
-    (mmrtm::NeedsGradientProxy(property, 0, labels) || now.Materials.Options.isosurface);
-  now.Proxies.ComponentGradients = 0;
-  for (int c = 0; c < now.Proxies.Independent; ++c)
-    now.Proxies.ComponentGradients |= mmrtm::UsesGradientOpacity(property, c) ? 1 << c : 0;
-  if (in.Warn("components", components > 4 && now.Proxies.Independent))
-    vtkWarningMacro("only the first 4 of " << components << " independent components are rendered");
-  if (in.Warn("mask with components", now.Proxies.Independent && in.Mask))
-    vtkWarningMacro("with independent components, the mask is not used");
-
-  now.Materials.Property = property;
-  now.Materials.PropertyTime = PropertyMTime(property);
-  now.Materials.MultiMaterialTime = in.MultiMaterial ? in.MultiMaterial->GetMTime() : 0;
-  now.Materials.LabelMaterialsTime = in.LabelMaterialsTime();
-
-  // Camera, lights, matrix, viewport (by value), clipping, the environment,
-  // the opaque geometry (its depth), and the mapper's own settings.
-  now.View.Width = viewport[0];
-  now.View.Height = viewport[1];
-  // VTK's still image: at the least distance when the distances adapt,
-  // else at ImageSampleDistance; below 1 is 1 (samples cover a pixel).
-  const double distance = std::max(1.0,
-    static_cast<double>(
-      this->AutoAdjustSampleDistances ? this->MinimumImageSampleDistance : this->ImageSampleDistance));
-  now.View.FilmWidth = FilmSize(viewport[0], distance);
-  now.View.FilmHeight = FilmSize(viewport[1], distance);
-  now.View.Values = ViewSignature(ren, vol, now.View.FilmWidth, now.View.FilmHeight);
-  now.View.Values.insert(
-    now.View.Values.end(), { static_cast<double>(now.View.Width), static_cast<double>(now.View.Height) });
-  now.View.Clip = this->ClipPlanes(vol);
-  for (const mmrtm::ClipPlane& p : now.View.Clip)
-    now.View.Values.insert(now.View.Values.end(), { p.normal.x, p.normal.y, p.normal.z, p.offset });
-  this->UpdateEnvironment();
-  now.View.Values.push_back(static_cast<double>(in.EnvironmentTime));
-  now.View.Depth = ReadDepth(ren, viewport[0], viewport[1], viewport[2], viewport[3]);
-  now.View.TracingTime = this->GetTracingMTime();
-  now.View.Renderer = ren;
-  now.View.Volume = vol;
-  const int* tiles = ren->GetRenderWindow()->GetTileScale();
-  now.View.Tile = tiles[0] > 1 || tiles[1] > 1;
-  return now;
-}
-
-void vtkMultiMaterialVolumeMapper::ReadTracedImage(InputState& now)
-{
-  // The input as the tracer's image (mmrtmTracedImage.h), converted again
-  // only when the input, its scalars or their modification times changed,
-  // so that an unchanged input does not rebuild.
-  Internals& in = *this->Internal;
-  vtkDataSet* input = this->GetInput();
-  int cellFlag = 0;
-  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
-    input, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
-  if (!scalars)
-    throw mmrtm::InputError(
-      std::string("the input (a ") + input->GetClassName() + ") has no scalars for the mapper's scalar mode");
-  Internals::Conversion& c = in.Converted;
-  const vtkMTimeType inputTime = input->GetMTime(), scalarsTime = scalars->GetMTime();
-  if (c.Input != input || c.InputTime != inputTime || c.Scalars != scalars || c.ScalarsTime != scalarsTime ||
-    c.Cell != (cellFlag != 0))
-  {
-    c = Internals::Conversion{};
-    c.Traced = mmrtm::ImageForTracing(input, scalars, cellFlag != 0);
-    c.Input = input;
-    c.InputTime = inputTime;
-    c.Scalars = scalars;
-    c.ScalarsTime = scalarsTime;
-    c.Cell = cellFlag != 0;
-  }
-  now.Proxies.Data = c.Traced.Image ? c.Traced.Image.Get() : vtkImageData::SafeDownCast(input);
-  now.Proxies.DataTime = inputTime;
-  now.Proxies.Scalars = c.Traced.Image ? c.Traced.Scalars : scalars;
-  const bool resampled = vtkRectilinearGrid::SafeDownCast(input) != nullptr;
-  if (in.Warn("rectilinear grid", resampled))
-    vtkWarningMacro(<< c.Traced.Conversion << " (VTK's GPU mapper samples the grid on its own coordinates)");
-}
-
-vtkMultiMaterialVolumeMapper::Changes vtkMultiMaterialVolumeMapper::ChangesSince(
-  const InputState& built, const InputState& now)
-{
-  Changes c;
-  c.Proxies = !this->Internal->HasScene || !(now.Proxies == built.Proxies);
-  const bool description = now.Proxies.MultiMaterial != nullptr;
-  c.Description = description &&
-    (now.Materials.MultiMaterialTime != built.Materials.MultiMaterialTime ||
-      now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime);
-  c.Materials = !description &&
-    (now.Materials.Property != built.Materials.Property || now.Materials.PropertyTime != built.Materials.PropertyTime ||
-      now.Materials.LabelMaterialsTime != built.Materials.LabelMaterialsTime ||
-      !(now.Materials.Options == built.Materials.Options));
-  c.View = !SameView(now.View.Values, built.View.Values) || now.View.Depth != built.View.Depth ||
-    now.View.TracingTime != built.View.TracingTime;
-  return c;
-}
-
-void vtkMultiMaterialVolumeMapper::UpdateProxies(const InputState& now)
-{
-  Internals& in = *this->Internal;
-  in.HasScene = false; // until the rebuild succeeds
-  const bool labels = now.Proxies.Mask && now.Proxies.MaskType == LABELMAP;
-  const InputState::ProxyInputs& p = now.Proxies;
-  this->BuildProxies(now.Materials.Property, p.Data, p.Scalars, p.Dependent, p.Independent, p.NeedGradient, labels);
-  int64_t nans = 0;
-  for (const mmrtm::HostVolume& v : in.Scene.proxies)
-    nans += v.nanVoxelsReplaced;
-  if (in.Warn("NaN voxels", nans > 0))
-    vtkWarningMacro(<< nans
-                    << " voxel value(s) of the input or mask are NaN; they are rendered as the volume's least "
-                       "value (empty where its opacity is 0)");
-  in.LightsFromScene = false;
-  if (now.Proxies.MultiMaterial)
-    this->ParseMultiMaterialScene();
-  for (const mmrtm::HostVolume& v : in.Scene.proxies)
-    in.ImageIndexToWorld.push_back(v.indexToWorld);
-  in.Scene.MarkDataModified();
-  in.Built.Proxies = now.Proxies;
-  in.Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime; // parsed over them
-  in.Built.Materials.LabelMaterialsTime = now.Materials.LabelMaterialsTime;
-  ++in.SceneBuilds;
-}
-
-void vtkMultiMaterialVolumeMapper::UpdateDescription(const InputState& now)
-{
-  // An edited description over unchanged data: parsed again over the
-  // proxies as they are, and refitted.
-  this->ReparseMultiMaterialScene();
-  this->Internal->Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime;
-  this->Internal->Built.Materials.LabelMaterialsTime = now.Materials.LabelMaterialsTime;
-}
-
-void vtkMultiMaterialVolumeMapper::UpdateMaterials(const InputState& now)
-{
-  // The transfer functions translated again (the scene's build refits).
-  Internals& in = *this->Internal;
-  if (const int nonFinite =
-        mmrtm::SetMaterialsFromProperty(now.Materials.Property, 0, in.Layout, now.Materials.Options, in.Scene))
-    vtkWarningMacro(<< "the volume property holds " << nonFinite
-                    << " value(s) that are not finite (NaN in a transfer function or a component "
-                       "weight); they were read as 0");
-  if (in.Layout.labels >= 0)
-  {
-    for (const auto& [label, look] : in.LabelLooks)
-      mmrtm::SetLabelLook(label, look, now.Materials.Property, 0, in.Layout, now.Materials.Options, in.Scene);
-    for (const auto& [label, json] : in.LabelMaterialParameters)
-      mmrtm::SetLabelMaterialParameters(label, json, in.Scene);
-  }
-  in.Built.Materials = now.Materials;
-  ++in.Refits;
-}
-
-void vtkMultiMaterialVolumeMapper::UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now)
-{
-  // A restart: a new film under the current camera, lights and settings.
-  Internals& in = *this->Internal;
-  vol->GetMatrix(in.Matrix);
-  const mmrtm::Affine3 propMatrix = ToAffine(in.Matrix);
-  for (size_t i = 0; i < in.Scene.proxies.size(); ++i)
-    in.Scene.proxies[i].indexToWorld = mmrtm::AffineCompose(propMatrix, in.ImageIndexToWorld[i]);
-  mmrtm::SetCameraFromVtk(ren->GetActiveCamera(), in.Scene);
-  const int width = now.View.FilmWidth, height = now.View.FilmHeight;
-  // Camera rays stop at opaque geometry: it hides the volume behind it,
-  // and the volume in front of it hides it.
-  in.Scene.cameraRayMaxDistance = now.View.Depth.empty()
-    ? std::vector<float>()
-    : CameraRayMaxDistance(
-        ren, DepthAtFilmPixels(now.View.Depth, now.View.Width, now.View.Height, width, height), width, height);
-  if (!in.LightsFromScene)
-    mmrtm::SetLightsFromVtk(ren, now.Materials.Property, in.Scene);
-  if (in.Environment)
-    in.Scene.environment = in.Environment;
-  in.Scene.clipPlanes = now.View.Clip;
-  in.Scene.cropping = CroppingRegions(this, vol);
-  mmrtm::RenderSettings& rs = in.Scene.render;
-  rs.width = width;
-  rs.height = height;
-  rs.threads = this->NumberOfThreads;
-  rs.exposure = static_cast<float>(this->Exposure);
-  rs.integrator.seed = static_cast<uint64_t>(this->Seed);
-  // Local lighting: shadow rays see (almost) nothing, and light scatters once.
-  rs.integrator.shadowExtinctionScale =
-    this->GlobalIllumination ? static_cast<float>(this->ShadowExtinctionScale) : kLocalLightingShadowScale;
-  // Materials that only glow (unshaded, as VTK) need no light and no bounce.
-  rs.integrator.maxBounces = !mmrtm::AnyMaterialScatters(in.Scene) ? 0
-    : this->GlobalIllumination                                     ? this->MaximumBounces
-                                                                   : 1;
-  rs.integrator.sampler = this->Sampler == INDEPENDENT ? mmrtm::PixelSampler::Independent : mmrtm::PixelSampler::Sobol;
-  rs.accelerator.kind = this->Accelerator == MACROCELL ? mmrtm::MajorantKind::Macrocell
-    : this->Accelerator == NO_ACCELERATOR              ? mmrtm::MajorantKind::Global
-                                                       : mmrtm::MajorantKind::Octree;
-  rs.integrator.backgroundVisible = false; // VTK's background shows through
-  rs.integrator.projection = this->Projection(now.Materials.Property);
-  this->TakeFilm(now);
-  in.Built.View = std::move(now.View);
-  in.HasScene = true;
-}
-
-// The film for the view `now`: the parked one when it was made under this very
-// view, else a new one (a restart). The film of the view before is parked
-// when the view is a tile, or another renderer's or volume's view of this
-// mapper, and the film before was neither a tile nor empty: after a
-// magnified screenshot, and between the views of a mapper shared by two
-// renderers, each view goes on accumulating.
-void vtkMultiMaterialVolumeMapper::TakeFilm(const InputState& now)
-{
-  Internals& in = *this->Internal;
-  const InputState::ViewInputs& view = now.View;
-  const InputState::ViewInputs& before = in.Built.View;
-  const bool otherView = view.Tile || view.Renderer != before.Renderer || view.Volume != before.Volume;
-  std::unique_ptr<mmrtm::Film> previous = std::move(in.Film);
-  const bool keepPrevious = otherView && previous && previous->Samples() > 0 && !before.Tile;
-  const InputState::ViewInputs& parked = in.ParkedView;
-  if (in.ParkedFilm && !view.Tile && SameView(view.Values, parked.Values) && view.Depth == parked.Depth &&
-    view.TracingTime == parked.TracingTime && view.Renderer == parked.Renderer && view.Volume == parked.Volume)
-  {
-    in.Film = std::move(in.ParkedFilm);
-  }
-  else
-  {
-    in.Film = std::make_unique<mmrtm::Film>(view.FilmWidth, view.FilmHeight);
-    in.Film->TrackDenoiserInputs();
-    ++in.Restarts;
-  }
-  if (keepPrevious)
-  {
-    in.ParkedFilm = std::move(previous);
-    in.ParkedView = before;
-  }
-  in.Shown.reset(); // the image of the view before
-  ++in.FilmGeneration;
-}
-
-mmrtm::ProjectionSettings vtkMultiMaterialVolumeMapper::Projection(vtkVolumeProperty* property)
-{
-  // VTK's projection blend modes (mmrtm/projection.h), sampled as VTK's GPU
-  // mapper samples them: with AutoAdjustSampleDistances on (its default) at
-  // the smallest spacing of the volume in world space, else SampleDistance.
-  Internals& in = *this->Internal;
-  mmrtm::ProjectionSettings p;
-  switch (this->BlendMode)
-  {
-    case vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND:
-      p.mode = mmrtm::IntensityProjection::Maximum;
-      break;
-    case vtkVolumeMapper::MINIMUM_INTENSITY_BLEND:
-      p.mode = mmrtm::IntensityProjection::Minimum;
-      break;
-    case vtkVolumeMapper::AVERAGE_INTENSITY_BLEND:
-      p.mode = mmrtm::IntensityProjection::Average;
-      break;
-    case vtkVolumeMapper::ADDITIVE_BLEND:
-      p.mode = mmrtm::IntensityProjection::Additive;
-      break;
-    default:
-      return p; // composite (and isosurface, warned about): traced
-  }
-  const mmrtm::HostVolume& volume = in.Scene.proxies.at(0);
-  float step = mmrtm::kInfinity;
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    const mmrtm::Affine3& m = volume.indexToWorld;
-    step = std::min(
-      step, std::sqrt(m.m[0][axis] * m.m[0][axis] + m.m[1][axis] * m.m[1][axis] + m.m[2][axis] * m.m[2][axis]));
-  }
-  p.step = step > 0.f ? step : 1.f;
-  if (!this->AutoAdjustSampleDistances && this->SampleDistance > 0.f)
-    p.step = this->SampleDistance;
-  const double unit = property->GetScalarOpacityUnitDistance(0);
-  p.opacityUnitDistance = unit > 0.0 ? static_cast<float>(unit) : 1.f;
-  p.valueRange[0] = in.Layout.scalarRange[0]; // the input's (BuildProxies), not scanned per restart
-  p.valueRange[1] = in.Layout.scalarRange[1];
-  p.averageRange[0] = static_cast<float>(std::max<double>(this->AverageIPScalarRange[0], -FLT_MAX));
-  p.averageRange[1] = static_cast<float>(std::min<double>(this->AverageIPScalarRange[1], FLT_MAX));
-  return p;
-}
-
-void vtkMultiMaterialVolumeMapper::UpdateRenderer()
-{
-  Internals& in = *this->Internal;
-  if (in.Renderer && in.RendererBackend == this->Backend && in.RendererThreads == this->NumberOfThreads)
-    return;
-  const mmrtm::Backend backend = this->Backend == CPU ? mmrtm::Backend::Cpu
-    : this->Backend == CUDA                           ? mmrtm::Backend::Cuda
-                                                      : mmrtm::Backend::Auto;
-  in.Renderer = mmrtm::MakeRenderer(
-    backend, this->NumberOfThreads, [this](const std::string& note) { vtkDebugMacro(<< note); });
-  in.RendererBackend = this->Backend;
-  in.RendererThreads = this->NumberOfThreads;
-  in.BackendDescription = in.Renderer->Description();
-}
-
-mmrtm::SceneView vtkMultiMaterialVolumeMapper::BuildScene()
-{
-  // A new volume's summary build reads every voxel (14 s for 8 GiB on two
-  // cores): VTK's ProgressEvent tells the application, on this thread.
-  mmrtm::Scene& scene = this->Internal->Scene;
-  scene.buildProgress = [this](double fraction) { this->UpdateProgress(fraction); };
-  return scene.Build();
-}
-
-const mmrtm::Film* vtkMultiMaterialVolumeMapper::Refine(bool restart)
-{
-  // The scene's build refits only when what a refit reads changed, so a
-  // render after a camera move keeps the majorants and takes microseconds.
-  Internals& in = *this->Internal;
-  const auto buildStart = std::chrono::steady_clock::now();
-  const mmrtm::SceneView sceneView = this->BuildScene();
-  if (in.Renderer) // a CUDA backend that fell back to the CPU says so
-    in.BackendDescription = in.Renderer->Description();
-  in.CountGridWork();
-  if (in.Scene.ExtinctionWarning() != in.LastExtinctionWarning) // once per change, not per render
-  {
-    in.LastExtinctionWarning = in.Scene.ExtinctionWarning();
-    if (!in.LastExtinctionWarning.empty())
-      vtkWarningMacro(<< in.LastExtinctionWarning);
-  }
-  if (restart && (in.Scene.GridRefittedByLastBuild() || !in.Scene.Grid()))
-    in.LastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
-  const int accumulated = static_cast<int>(in.Film->Samples());
-  // A tile of a magnified screenshot is drawn once: with as many samples
-  // as the view it magnifies has. A projection needs one.
-  const bool projecting = in.Scene.render.integrator.projection.mode != mmrtm::IntensityProjection::None;
-  const int perRender = projecting        ? 1
-    : in.Built.View.Tile && in.ParkedFilm ? std::max(this->SamplesPerRender, static_cast<int>(in.ParkedFilm->Samples()))
-                                          : this->SamplesPerRender;
-  const int samples = this->FilmConverged() ? 0
-    : this->MaximumSamples > 0              ? std::min(perRender, this->MaximumSamples - accumulated)
-                                            : perRender;
-  const bool background = this->AsynchronousRefinement && !restart && accumulated > 0 && in.Shown;
-  if (background && this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, in.Shown->Samples(), samples > 0) &&
-    this->DenoiserReady())
-  {
-    // A denoise of the image shown, before more samples: on the thread of
-    // the passes, so that this render returns at once.
-    auto pass = std::make_unique<Internals::Pass>();
-    Internals::Pass* p = pass.get();
-    p->Denoising = true;
-    auto snapshot = std::make_shared<mmrtm::FilmSnapshot>(mmrtm::SnapshotFilm(*in.Shown, in.FilmGeneration));
-    const bool estimate = in.Display.WantsEstimate(in.FilmGeneration, in.Shown->Samples());
-    mmrtm::Denoiser* denoiser = in.Denoiser.get();
-    in.Display.Started();
-    p->Thread = std::thread(
-      [p, snapshot, estimate, denoiser]
-      {
-        try
-        {
-          p->Denoised = mmrtm::DenoiseSnapshot(*snapshot, estimate, true, mmrtm::OidnDenoise(*denoiser), &p->Cancel);
-        }
-        catch (const std::exception& e)
-        {
-          p->Error = e.what();
-        }
-        p->Done = true;
-      });
-    in.InFlight = std::move(pass);
-    return in.Shown.get();
-  }
-  if (samples > 0)
-    ++in.TracedPasses;
-  if (samples > 0 && background)
-  {
-    // The next pass on a thread of its own, under in.Built; this render
-    // draws the last finished image.
-    auto pass = std::make_unique<Internals::Pass>();
-    Internals::Pass* p = pass.get();
-    mmrtm::Renderer* renderer = in.Renderer.get();
-    mmrtm::Film* film = in.Film.get();
-    const mmrtm::Scene* scene = &in.Scene;
-    p->Thread = std::thread(
-      [p, renderer, film, scene, sceneView, samples]
-      {
-        try
-        {
-          p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
-        }
-        catch (const std::exception& e)
-        {
-          p->Error = e.what();
-        }
-        p->Done = true;
-      });
-    in.InFlight = std::move(pass);
-    return in.Shown.get();
-  }
-  if (samples > 0)
-    in.Renderer->Render(in.Scene, sceneView, *in.Film, samples, nullptr, nullptr);
-  if (this->AsynchronousRefinement)
-    in.Shown = std::make_unique<mmrtm::Film>(*in.Film);
-  else if (this->DenoisingApplies() && in.Display.Due(in.FilmGeneration, in.Film->Samples(), !this->FilmConverged()) &&
-    this->DenoiserReady())
-  {
-    // Synchronous refinement: the denoise after the pass, in this render.
-    in.Display.Started();
-    std::optional<mmrtm::DenoisedFilm> denoised;
-    try
-    {
-      denoised = mmrtm::DenoiseSnapshot(mmrtm::SnapshotFilm(*in.Film, in.FilmGeneration),
-        in.Display.WantsEstimate(in.FilmGeneration, in.Film->Samples()), true, mmrtm::OidnDenoise(*in.Denoiser));
-    }
-    catch (const std::exception& e)
-    {
-      vtkErrorMacro("Render: the denoiser failed: " << e.what());
-    }
-    in.Display.Finished(std::move(denoised));
-  }
-  return in.Film.get();
-}
-
-bool vtkMultiMaterialVolumeMapper::DenoisingApplies()
-{
-  // A projection's one sample is its image: there is no noise to take out.
-  return this->DenoisingMode != DENOISING_OFF &&
-    this->Internal->Scene.render.integrator.projection.mode == mmrtm::IntensityProjection::None;
-}
-
-bool vtkMultiMaterialVolumeMapper::DenoiserReady()
-{
-  Internals& in = *this->Internal;
-  if (!in.Denoiser && !in.DenoiserLoadTried)
-  {
-    in.DenoiserLoadTried = true;
-    try
-    {
-      in.Denoiser = mmrtm::Denoiser::Load(this->NumberOfThreads);
-    }
-    catch (const mmrtm::DenoiserError& e)
-    {
-      // Said once in full; the status names it while a denoising mode is on.
-      const std::string why = e.what();
-      in.Display.SetUnavailable(why.substr(0, why.find(" (")));
-      vtkWarningMacro(<< why);
-    }
-  }
-  return in.Denoiser != nullptr;
-}
-
-// The proxies of the input (its components as the property uses them), the
-// gradient magnitude when some function reads it, and the mask.
-void vtkMultiMaterialVolumeMapper::BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars,
-  int dependent, int independent, bool needGradient, bool labels)
-{
-  Internals& in = *this->Internal;
-  vtkImageData* mask = independent ? nullptr : in.Mask.Get();
-  mmrtm::Scene& scene = in.Scene;
-  scene.proxies.clear();
-  in.ImageIndexToWorld.clear();
-  in.Layout = mmrtm::ProxyLayout();
-  auto component = [&](int c, const char* name)
-  {
-    scene.proxies.push_back(mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
-    return static_cast<int>(scene.proxies.size()) - 1;
-  };
-  component(0, dependent == 4 ? "red" : "scalars");
-  in.Layout.scalarRange = scene.proxies[0].ValueRange();
-  scene.gradientProxy = 0;
-  if (independent)
-  {
-    in.Layout.independent = independent;
-    in.Layout.componentRanges[0] = in.Layout.scalarRange;
-    for (int c = 1; c < independent; ++c)
-      in.Layout.componentRanges[c] = scene.proxies[component(c, "component")].ValueRange();
-    // Gradient magnitudes of the components with gradient opacity, while
-    // there is room among the proxies.
-    for (int c = 0; c < independent; ++c)
-    {
-      if (!mmrtm::UsesGradientOpacity(property, c))
-        continue;
-      if (scene.proxies.size() >= static_cast<size_t>(mmrtm::kMaxProxies))
-      {
-        vtkWarningMacro("no room for the gradient of component " << c << ": its gradient opacity is not used");
-        continue;
-      }
-      in.Layout.componentGradient[c] = static_cast<int>(scene.proxies.size());
-      scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[c], "gradient"));
-      in.Layout.componentGradientRanges[c] = scene.proxies.back().ValueRange();
-    }
-  }
-  if (dependent == 2)
-  {
-    in.Layout.opacity = component(1, "opacity");
-  }
-  else if (dependent == 4)
-  {
-    in.Layout.rgb[0] = 0;
-    in.Layout.rgb[1] = component(1, "green");
-    in.Layout.rgb[2] = component(2, "blue");
-    in.Layout.opacity = component(3, "opacity");
-    float top = 0.f;
-    for (int c = 0; c < 3; ++c)
-      top = std::max(top, scene.proxies[c].ValueRange()[1]);
-    in.Layout.colorScale = scalars->GetDataType() == VTK_UNSIGNED_CHAR ? 255.f : std::max(top, 1e-6f);
-  }
-  if (in.Layout.opacity >= 0)
-  {
-    in.Layout.opacityRange = scene.proxies[in.Layout.opacity].ValueRange();
-    scene.gradientProxy = in.Layout.opacity; // VTK shades dependent data by the opacity component
-  }
-  if (needGradient)
-  {
-    const int source = scene.gradientProxy;
-    in.Layout.gradient = static_cast<int>(scene.proxies.size());
-    scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[source], "gradient"));
-    in.Layout.gradientRange = scene.proxies.back().ValueRange();
-  }
-  if (mask)
-  {
-    // Labels are never interpolated; a mask on another grid is put on
-    // the input's by nearest neighbour in world space.
-    mmrtm::HostVolume m =
-      mmrtm::ImageDataToHostVolume(mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
-    m = mmrtm::AlignLabelsToVolume(std::move(m), scene.proxies[0]);
-    (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
-    scene.proxies.push_back(std::move(m));
-  }
-  if (scene.proxies.size() > mmrtm::kMaxProxies)
-    throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
-      std::to_string(scene.proxies.size()) + " proxy volumes; at most " + std::to_string(mmrtm::kMaxProxies) +
-      " are supported");
-}
-
-void vtkMultiMaterialVolumeMapper::UpdateEnvironment()
-{
-  Internals& in = *this->Internal;
-  vtkTexture* texture = in.EnvironmentTexture;
-  vtkImageData* image = texture ? vtkImageData::SafeDownCast(texture->GetInput()) : nullptr;
-  if (texture && texture->GetInputAlgorithm())
-  {
-    texture->GetInputAlgorithm()->Update();
-    image = vtkImageData::SafeDownCast(texture->GetInput());
-  }
-  const vtkMTimeType time = image ? std::max(image->GetMTime(), texture->GetMTime()) : 0;
-  if (time == in.EnvironmentTime && this->EnvironmentIntensity == in.EnvironmentScale)
-    return;
-  in.EnvironmentTime = time;
-  in.EnvironmentScale = this->EnvironmentIntensity;
-  in.Environment.reset();
-  if (!image)
-    return;
-  vtkDataArray* a = image->GetPointData()->GetScalars();
-  const int* d = image->GetDimensions();
-  if (!a || a->GetNumberOfComponents() < 3 || d[2] != 1 || d[0] < 1 || d[1] < 1)
-  {
-    vtkErrorMacro("the environment texture needs a 2D image with 3 or 4 components");
-    return;
-  }
-  // sRGB bytes to linear; float data is radiance already. VTK's rows run
-  // bottom up, the environment's from the zenith down.
-  const bool bytes = a->GetDataType() == VTK_UNSIGNED_CHAR;
-  auto linear = [bytes](double v)
-  {
-    if (!bytes)
-      return static_cast<float>(std::max(v, 0.0));
-    v /= 255.0;
-    return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-  };
-  std::vector<mmrtm::RGB> texels(static_cast<size_t>(d[0]) * d[1]);
-  const float scale = static_cast<float>(this->EnvironmentIntensity);
-  for (int y = 0; y < d[1]; ++y)
-    for (int x = 0; x < d[0]; ++x)
-    {
-      const vtkIdType i = x + static_cast<vtkIdType>(d[0]) * (d[1] - 1 - y);
-      texels[static_cast<size_t>(y) * d[0] + x] = mmrtm::RGB(linear(a->GetComponent(i, 0)) * scale,
-        linear(a->GetComponent(i, 1)) * scale, linear(a->GetComponent(i, 2)) * scale);
-    }
-  in.Environment = std::make_shared<mmrtm::EnvironmentMap>(d[0], d[1], std::move(texels));
-}
-
-void vtkMultiMaterialVolumeMapper::ParseMultiMaterialScene()
-{
-  // The description over the mapper's volumes: its input as "scalars" (and
-  // the mask as "labels"); the camera and image size stay VTK's. The
-  // labels' looks (SetLabelMaterial) are classes of the description's
-  // label materials, ahead of its own.
-  Internals& in = *this->Internal;
-  nlohmann::json doc = in.MultiMaterial->GetScene();
-  doc.erase("camera");
-  doc.erase("volumes"); // a description's own files are not the mapper's data
-  if (in.Layout.labels >= 0)
-    doc = mmrtm::WithLabelLooks(std::move(doc), in.LabelLooksWithParameters());
-  mmrtm::SceneInputs inputs;
-  inputs.volumes["scalars"] = std::move(in.Scene.proxies[0]);
-  for (size_t i = 1; i < in.Scene.proxies.size(); ++i)
-    if (static_cast<int>(i) == in.Layout.labels || static_cast<int>(i) == in.Layout.binaryMask)
-      inputs.volumes["labels"] = std::move(in.Scene.proxies[i]);
-  in.LightsFromScene = doc.contains("lights");
-  in.Scene = mmrtm::SceneFromJson(doc, std::move(inputs));
-  const std::array<float, 2> range = in.Layout.scalarRange; // the input's, for the projections
-  in.Layout = mmrtm::ProxyLayout();
-  in.Layout.scalarRange = range;
-  ++in.Refits;
-}
-
-void vtkMultiMaterialVolumeMapper::ReparseMultiMaterialScene()
-{
-  // The description is parsed over the proxies of the last build (the
-  // input and the mask, moved with their buffers and given back their own
-  // index-to-world: the volume's matrix is applied at the restart). The
-  // grid's summaries go over to the new scene when its proxies are those
-  // very buffers, so that the edit costs a refit.
-  Internals& in = *this->Internal;
-  in.HasScene = false; // until the parse succeeds; after a failure the input is read again
-  mmrtm::Scene previous = std::move(in.Scene);
-  in.Scene = mmrtm::Scene();
-  const std::array<float, 2> range = in.Layout.scalarRange; // the input's, for the projections
-  in.Layout = mmrtm::ProxyLayout();
-  in.Layout.scalarRange = range;
-  const int labels = previous.ProxyIndex("labels");
-  for (const int i : { 0, labels })
-  {
-    if (i < 0 || i >= static_cast<int>(previous.proxies.size()))
-      continue;
-    mmrtm::HostVolume volume = std::move(previous.proxies[i]);
-    volume.indexToWorld = in.ImageIndexToWorld.at(i);
-    if (i == labels)
-      in.Layout.labels = static_cast<int>(in.Scene.proxies.size());
-    in.Scene.proxies.push_back(std::move(volume));
-  }
-  this->ParseMultiMaterialScene();
-  in.Scene.AdoptDataSummariesFrom(previous);
-  in.ImageIndexToWorld.clear();
-  for (const mmrtm::HostVolume& v : in.Scene.proxies)
-    in.ImageIndexToWorld.push_back(v.indexToWorld);
-  in.HasScene = true;
-}
-
-std::vector<mmrtm::ClipPlane> vtkMultiMaterialVolumeMapper::ClipPlanes(vtkVolume* vol)
-{
-  std::vector<mmrtm::ClipPlane> planes;
-  // Clipping planes, in world space: the side the normal points to is kept.
-  if (this->ClippingPlanes)
-  {
-    this->ClippingPlanes->InitTraversal();
-    while (vtkPlane* plane = this->ClippingPlanes->GetNextItem())
-    {
-      const double* n = plane->GetNormal();
-      const double* o = plane->GetOrigin();
-      mmrtm::ClipPlane p;
-      p.normal = { static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2]) };
-      p.offset = static_cast<float>(-(n[0] * o[0] + n[1] * o[1] + n[2] * o[2]));
-      planes.push_back(p);
-    }
-  }
-  // Subvolume cropping, in the data's coordinates (before the volume's
-  // matrix): six axis-aligned half-spaces, taken to world space through the
-  // inverse transpose of the matrix.
-  if (this->Cropping && this->CroppingRegionFlags == VTK_CROP_SUBVOLUME)
-  {
-    vtkNew<vtkMatrix4x4> inverse;
-    vol->GetMatrix(inverse);
-    inverse->Invert();
-    for (int axis = 0; axis < 3; ++axis)
-      for (int side = 0; side < 2; ++side)
-      {
-        // Data space: sign * (x[axis] - bound) >= 0.
-        const double sign = side == 0 ? 1.0 : -1.0, bound = this->CroppingRegionPlanes[2 * axis + side];
-        double n[3], d = -sign * bound;
-        for (int c = 0; c < 3; ++c)
-          n[c] = sign * inverse->GetElement(axis, c);
-        d += sign * inverse->GetElement(axis, 3);
-        mmrtm::ClipPlane p;
-        p.normal = { static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2]) };
-        p.offset = static_cast<float>(d);
-        planes.push_back(p);
-      }
-  }
-  const bool tooMany = static_cast<int>(planes.size()) > mmrtm::kMaxClipPlanes;
-  if (this->Internal->Warn("clipping planes", tooMany))
-    vtkWarningMacro("only " << mmrtm::kMaxClipPlanes << " clipping and cropping planes are used");
-  if (tooMany)
-    planes.resize(mmrtm::kMaxClipPlanes);
-  return planes;
-}
-
-double vtkMultiMaterialVolumeMapper::RenderPreview(vtkRenderer* ren, int width, int height)
-{
-  Internals& in = *this->Internal;
-  const double distance = this->AutoAdjustSampleDistances
-    ? in.PreviewDistance
-    : std::max(1.0, static_cast<double>(this->ImageSampleDistance));
-  const int w = FilmSize(width, distance), h = FilmSize(height, distance);
-  mmrtm::RenderSettings& rs = in.Scene.render;
-  rs.width = w;
-  rs.height = h;
-  const std::vector<float>& fullDepth = in.Built.View.Depth;
-  if (!fullDepth.empty())
-    in.Scene.cameraRayMaxDistance = CameraRayMaxDistance(ren, DepthAtFilmPixels(fullDepth, width, height, w, h), w, h);
-  const mmrtm::SceneView view = this->BuildScene();
-  in.CountGridWork();
-  in.Preview = std::make_unique<mmrtm::Film>(w, h);
-  const auto start = std::chrono::steady_clock::now();
-  in.Renderer->Render(in.Scene, view, *in.Preview, 1, nullptr, nullptr);
-  ++in.TracedPasses;
-  // Denoised on its colour alone, at OIDN's fast quality: one sample's
-  // guides are as noisy as its colour, and the frame has a budget.
-  in.PreviewDenoised.reset();
-  if (this->DenoisingApplies() && this->DenoiserReady())
-  {
-    const auto denoiseStart = std::chrono::steady_clock::now();
-    in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Fast);
-    try
-    {
-      in.PreviewDenoised =
-        mmrtm::DenoiseSnapshot(mmrtm::SnapshotFilm(*in.Preview, 0), false, false, mmrtm::OidnDenoise(*in.Denoiser));
-    }
-    catch (const mmrtm::DenoiserError& e)
-    {
-      vtkErrorMacro("Render: the denoiser failed: " << e.what());
-    }
-    in.Denoiser->SetQuality(mmrtm::Denoiser::Quality::Balanced);
-    in.PreviewDenoiseSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - denoiseStart).count();
-    ++in.PreviewDenoises;
-  }
-  // The still render after the interaction starts again at full resolution.
-  in.Film.reset();
-  ++in.InteractiveRenders;
-  // The denoise scales with the pixels as the tracing does (AdaptPreview).
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-void vtkMultiMaterialVolumeMapper::AdaptPreview(double seconds, double tracedSeconds, double budgetSeconds)
-{
-  // The tracing time scales with the film's pixels, 1 / distance^2; the
-  // rest of the frame (reading the inputs and the depth, drawing) is taken
-  // as fixed. The distance that would have fit the budget, averaged
-  // (geometrically) with the one used, so that one noisy frame does not
-  // swing the next.
-  Internals& in = *this->Internal;
-  if (!this->AutoAdjustSampleDistances)
-    return;
-  const double least = std::max(1.0, static_cast<double>(this->MinimumImageSampleDistance));
-  const double most = std::max(least, static_cast<double>(this->MaximumImageSampleDistance));
-  const double d = in.PreviewDistance;
-  const double forTracing = std::max(0.1 * budgetSeconds, budgetSeconds - (seconds - tracedSeconds));
-  const double fits = d * std::sqrt(std::max(tracedSeconds, 1e-6) / forTracing);
-  in.PreviewDistance = std::min(most, std::max(least, std::sqrt(d * fits)));
 }
 
 void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, const mmrtm::Film& film)
@@ -1983,18 +673,18 @@ void vtkMultiMaterialVolumeMapper::DrawFilm(vtkRenderer* ren, vtkVolume* vol, co
     }
     in.LastShown = Internals::ShownImage::Preview;
   }
-  else if (&film == this->ImageFilm())
+  else if (&film == this->Internal->ImageFilm())
   {
     in.LastShown = Internals::ShownImage::Film;
     in.Display.Recheck(film, in.FilmGeneration);
     const mmrtm::DenoisedFilm* shown =
-      this->DenoisingApplies() ? in.Display.Shown(in.FilmGeneration, film.Samples()) : nullptr;
+      this->Internal->DenoisingApplies() ? in.Display.Shown(in.FilmGeneration, film.Samples()) : nullptr;
     if (shown)
     {
       denoised = &shown->image;
       denoisedAlpha = &shown->alpha;
     }
-    else if (this->DenoisingApplies() && in.PreviewDenoised && in.PreviewStandsFor == in.FilmGeneration &&
+    else if (this->Internal->DenoisingApplies() && in.PreviewDenoised && in.PreviewStandsFor == in.FilmGeneration &&
       !in.Display.HasDenoised(in.FilmGeneration))
     {
       denoised = &in.PreviewDenoised->image;

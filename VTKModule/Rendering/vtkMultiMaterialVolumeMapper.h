@@ -686,38 +686,6 @@ protected:
 
 private:
   vtkMultiMaterialVolumeMapper(const vtkMultiMaterialVolumeMapper&) = delete;
-  struct InputState;
-  struct Changes;
-  // The phases of Render, in order.
-  bool ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4]);
-  InputState ReadInputs(vtkRenderer* ren, vtkVolume* vol, const int viewport[4]);
-  void ReadTracedImage(InputState& now); // the input as the tracer's image (part of ReadInputs)
-  void RenderFrame(vtkRenderer* ren, vtkVolume* vol);
-  bool TracesInThisFrame(vtkRenderer* ren);
-  Changes ChangesSince(const InputState& built, const InputState& now);
-  void UpdateProxies(const InputState& now);
-  void UpdateDescription(const InputState& now);
-  void UpdateMaterials(const InputState& now);
-  void UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now);
-  void TakeFilm(const InputState& now);
-  void UpdateRenderer();
-  mmrtm::ProjectionSettings Projection(vtkVolumeProperty* property);
-  mmrtm::SceneView BuildScene(); // the scene's Build, its summary build reported as VTK progress
-  const mmrtm::Film* Refine(bool restart);
-  double RenderPreview(vtkRenderer* ren, int width, int height); // the tracing's seconds
-  void AdaptPreview(double seconds, double tracedSeconds, double budgetSeconds);
-  std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
-  void ParseMultiMaterialScene();
-  void ReparseMultiMaterialScene();
-  void FinishPass(bool cancel);
-  bool FilmConverged();    // the accumulation has reached MaximumSamples or NoiseTarget
-  bool DenoisingApplies(); // a denoising mode, and noise to take out (not a projection)
-  bool DenoiserReady();    // loads it at the first call
-  bool InputWillExecute();
-  const mmrtm::Film* ImageFilm();
-  void UpdateEnvironment();
-  void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
-    int independent, bool needGradient, bool labels);
   void operator=(const vtkMultiMaterialVolumeMapper&) = delete;
 
   struct Internals;

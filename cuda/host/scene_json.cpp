@@ -12,7 +12,6 @@
 
 #include "derived_proxies.h"
 #include "label_alignment.h"
-#include "label_materials.h"
 
 namespace mmrtm {
 
@@ -138,7 +137,7 @@ class Parser {
               {"volumes", "materials", "material_tfs", "default_material", "gradient_proxy", "lights", "camera",
                "render", "description", "label_materials", "label_table", "additive_materials"});
     ParseVolumes();
-    ExpandLabels();
+    ExpandDocument();
     ParseMaterialNames();
     for (auto it = Materials().begin(); it != Materials().end(); ++it) ParseMaterial(it.key(), it.value());
     ParseMaterialTFs();
@@ -270,24 +269,23 @@ class Parser {
     return OpacityProxy(source, d.points, name);
   }
 
-  // "label_materials" (label_materials.h): one material per label id present
-  // in the label map, named and coloured from the label table.
-  void ExpandLabels() {
-    std::optional<LabelTable> table = in_.labelTable;
-    if (!table && doc_.contains("label_table")) {
-      if (!doc_["label_table"].is_string()) Fail("label_table", "expected a file name");
-      table = ReadLabelTable(Resolve(doc_["label_table"].get<std::string>(), in_.baseDirectory));
+  // Blocks a front end's library expands once the volumes are read (the
+  // labels library's "label_materials" and "label_table").
+  void ExpandDocument() {
+    if (!in_.expandDocument) {
+      for (const char* key : {"label_materials", "label_table"})
+        if (doc_.contains(key))
+          Fail(key, "label classes are expanded by the labels library (mmrtm::ExpandLabelMaterialsOnLoad)");
+      return;
     }
-    if (!doc_.contains("label_materials")) return;
-    const json& block = doc_["label_materials"];
-    const std::string proxy = block.is_object() ? block.value("proxy", std::string("labels")) : "labels";
-    int index = -1;
-    for (size_t i = 0; i < volumeNames_.size(); ++i)
-      if (volumeNames_[i] == proxy && !derived_[i]) index = (int)i;
-    if (index < 0)
-      Fail("label_materials.proxy",
-           "needs the label map '" + proxy + "' (give --labels FILE, or a volume of that name)");
-    doc_ = ExpandLabelMaterials(doc_, LabelIdsPresent(volumes_[index]), table ? &*table : nullptr);
+    doc_ = in_.expandDocument(
+        doc_,
+        [&](const std::string& name) -> const HostVolume* {
+          for (size_t i = 0; i < volumeNames_.size(); ++i)
+            if (volumeNames_[i] == name && !derived_[i]) return &volumes_[i];
+          return nullptr;
+        },
+        in_.baseDirectory);
   }
 
   int ProxyByName(const std::string& name, const std::string& where) {
@@ -589,7 +587,7 @@ class Parser {
     }
   }
 
-  json doc_;  // a copy: "label_materials" is expanded in place
+  json doc_;  // a copy: expanded in place (ExpandDocument)
   SceneInputs in_;
   Scene scene_;
   std::vector<HostVolume> volumes_;

@@ -9,7 +9,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "label_table.h"
 #include "scene.h"
 
 namespace mmrtm {
@@ -18,6 +17,13 @@ namespace mmrtm {
 // application (the readers live outside cuda/).
 using VolumeLoader = std::function<HostVolume(const std::string& path, const std::string& name, Interpolation)>;
 
+// Returns the document with blocks of its own replaced by what they stand
+// for; `volume` gives a volume read from the document or the inputs by
+// proxy name (null when there is none), `baseDirectory` is the inputs'.
+using VolumeByName = std::function<const HostVolume*(const std::string& name)>;
+using DocumentExpansion = std::function<nlohmann::json(nlohmann::json doc, const VolumeByName& volume,
+                                                       const std::string& baseDirectory)>;
+
 struct SceneInputs {
   VolumeLoader loadVolume;
   // Volumes given outside the scene file (the command line's INPUT and
@@ -25,9 +31,12 @@ struct SceneInputs {
   std::map<std::string, HostVolume> volumes;
   // Folder that relative file names in the document are relative to.
   std::string baseDirectory = ".";
-  // Label names and colours for "label_materials" (the command line's
-  // --label-table); takes the place of the scene's "label_table" file.
-  std::optional<LabelTable> labelTable;
+  // A front end's expansion of the document's label classes
+  // ("label_materials", "label_table"), called once the volumes are read:
+  // the labels library's (Labels/label_materials.h,
+  // ExpandLabelMaterialsOnLoad). Without it a document with those blocks
+  // is an error.
+  DocumentExpansion expandDocument;
 };
 
 // Reads a JSON document from a file; throws InputError naming the file and

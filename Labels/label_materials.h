@@ -1,11 +1,14 @@
 // One material per label of a segmentation (the scene's "label_materials"
 // block): organs, vessels and bones of a label map become distinct
 // materials, named and coloured from a label table, chosen by an MDPTF over
-// the label proxy. Host-only set-up code (a JSON transformation).
+// the label proxy; and a label as a front end shows it (LabelLook). The
+// front ends' label library (JSON transformations before the tracer's scene
+// is built), not the tracer's.
 #pragma once
 
 #include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +16,7 @@
 
 #include "host_volume.h"
 #include "label_table.h"
+#include "scene_json.h"
 
 namespace mmrtm {
 
@@ -70,6 +74,15 @@ std::vector<int> LabelIdsPresent(const HostVolume& labels);
 // Errors name the JSON path. A document without "label_materials" is
 // returned unchanged.
 nlohmann::json ExpandLabelMaterials(nlohmann::json doc, const std::vector<int>& ids, const LabelTable* table);
+
+// The scene format's label classes for SceneFromJson: sets
+// inputs.expandDocument to ExpandLabelMaterials over the ids present in the
+// label map that "label_materials" names (its "proxy", default "labels"),
+// with the names and colours of `table` (the command line's --label-table)
+// or else of the document's "label_table" file (relative to the inputs'
+// base directory). Throws InputError naming "label_materials.proxy" when
+// there is no such label map.
+void ExpandLabelMaterialsOnLoad(SceneInputs& inputs, std::optional<LabelTable> table = std::nullopt);
 
 // The document with each look a class of its own ({"ids": [label], "color":
 // "material", "material": LabelMaterial(look)}), ahead of the document's

@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 namespace mmrtm {
 namespace {
 
 using nlohmann::json;
+namespace fs = std::filesystem;
 
 [[noreturn]] void Fail(const std::string& where, const std::string& problem) {
   throw InputError(where + ": " + problem);
@@ -165,6 +167,27 @@ json LabelMaterial(const LabelLook& look) {
     m[key] = value;
   }
   return m;
+}
+
+void ExpandLabelMaterialsOnLoad(SceneInputs& inputs, std::optional<LabelTable> table) {
+  inputs.expandDocument = [table = std::move(table)](json doc, const VolumeByName& volume,
+                                                     const std::string& baseDirectory) {
+    std::optional<LabelTable> names = table;
+    if (doc.contains("label_table")) {
+      if (!doc["label_table"].is_string()) Fail("label_table", "expected a file name");
+      const fs::path file = doc["label_table"].get<std::string>();
+      if (!names) names = ReadLabelTable((file.is_absolute() ? file : fs::path(baseDirectory) / file).string());
+      doc.erase("label_table");
+    }
+    if (!doc.contains("label_materials")) return doc;
+    const json& block = doc["label_materials"];
+    const std::string proxy = block.is_object() ? block.value("proxy", std::string("labels")) : "labels";
+    const HostVolume* labels = volume(proxy);
+    if (!labels)
+      Fail("label_materials.proxy",
+           "needs the label map '" + proxy + "' (give --labels FILE, or a volume of that name)");
+    return ExpandLabelMaterials(std::move(doc), LabelIdsPresent(*labels), names ? &*names : nullptr);
+  };
 }
 
 json WithLabelLooks(json doc, const std::map<int, LabelLook>& looks) {
