@@ -19,7 +19,10 @@
 #include <vtkSmartPointer.h>
 #include <vtkVolumeProperty.h>
 
+#include "derived_proxies.h"
+#include "label_alignment.h"
 #include "mmrtm/planted_defect.h"
+#include "mmrtmImageDataConversion.h"
 #include "mmrtmVolumePropertyFunctions.h"
 #include "scene_json.h"
 
@@ -701,6 +704,86 @@ void SetLabelMaterialParameters(int label, const std::string& json, Scene& scene
       throw InputError(
         where + ": unknown key '" + key + "' (roughness, metallic, surface_probability, anisotropy, emission)");
   }
+}
+
+ProxyLayout BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, vtkImageData* mask,
+  int dependent, int independent, bool needGradient, bool labels, Scene& scene,
+  const std::function<void(const std::string&)>& warn)
+{
+  scene.proxies.clear();
+  ProxyLayout layout;
+  auto component = [&](int c, const char* name)
+  {
+    scene.proxies.push_back(ImageDataToHostVolume(input, scalars, c, name, Interpolation::Trilinear));
+    return static_cast<int>(scene.proxies.size()) - 1;
+  };
+  component(0, dependent == 4 ? "red" : "scalars");
+  layout.scalarRange = scene.proxies[0].ValueRange();
+  scene.gradientProxy = 0;
+  if (independent)
+  {
+    layout.independent = independent;
+    layout.componentRanges[0] = layout.scalarRange;
+    for (int c = 1; c < independent; ++c)
+      layout.componentRanges[c] = scene.proxies[component(c, "component")].ValueRange();
+    // Gradient magnitudes of the components with gradient opacity, while
+    // there is room among the proxies.
+    for (int c = 0; c < independent; ++c)
+    {
+      if (!UsesGradientOpacity(property, c))
+        continue;
+      if (scene.proxies.size() >= static_cast<size_t>(kMaxProxies))
+      {
+        warn("no room for the gradient of component " + std::to_string(c) + ": its gradient opacity is not used");
+        continue;
+      }
+      layout.componentGradient[c] = static_cast<int>(scene.proxies.size());
+      scene.proxies.push_back(GradientMagnitudeProxy(scene.proxies[c], "gradient"));
+      layout.componentGradientRanges[c] = scene.proxies.back().ValueRange();
+    }
+  }
+  if (dependent == 2)
+  {
+    layout.opacity = component(1, "opacity");
+  }
+  else if (dependent == 4)
+  {
+    layout.rgb[0] = 0;
+    layout.rgb[1] = component(1, "green");
+    layout.rgb[2] = component(2, "blue");
+    layout.opacity = component(3, "opacity");
+    float top = 0.f;
+    for (int c = 0; c < 3; ++c)
+      top = std::max(top, scene.proxies[c].ValueRange()[1]);
+    layout.colorScale = scalars->GetDataType() == VTK_UNSIGNED_CHAR ? 255.f : std::max(top, 1e-6f);
+  }
+  if (layout.opacity >= 0)
+  {
+    layout.opacityRange = scene.proxies[layout.opacity].ValueRange();
+    scene.gradientProxy = layout.opacity; // VTK shades dependent data by the opacity component
+  }
+  if (needGradient)
+  {
+    const int source = scene.gradientProxy;
+    layout.gradient = static_cast<int>(scene.proxies.size());
+    scene.proxies.push_back(GradientMagnitudeProxy(scene.proxies[source], "gradient"));
+    layout.gradientRange = scene.proxies.back().ValueRange();
+  }
+  if (mask)
+  {
+    // Labels are never interpolated; a mask on another grid is put on
+    // the input's by nearest neighbour in world space.
+    HostVolume m =
+      ImageDataToHostVolume(mask, nullptr, 0, labels ? "label map" : "mask", Interpolation::Nearest);
+    m = AlignLabelsToVolume(std::move(m), scene.proxies[0]);
+    (labels ? layout.labels : layout.binaryMask) = static_cast<int>(scene.proxies.size());
+    scene.proxies.push_back(std::move(m));
+  }
+  if (scene.proxies.size() > kMaxProxies)
+    throw InputError("this combination of components, gradient opacity and mask needs " +
+      std::to_string(scene.proxies.size()) + " proxy volumes; at most " + std::to_string(kMaxProxies) +
+      " are supported");
+  return layout;
 }
 
 void SetCameraFromVtk(vtkCamera* camera, Scene& scene)

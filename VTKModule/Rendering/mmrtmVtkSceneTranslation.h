@@ -49,6 +49,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,8 @@
 #include "scene.h"
 
 class vtkCamera;
+class vtkDataArray;
+class vtkImageData;
 class vtkRenderer;
 class vtkVolumeProperty;
 
@@ -113,6 +116,20 @@ struct ProxyLayout
   std::array<int, 4> componentGradient{ -1, -1, -1, -1 };
   std::array<std::array<float, 2>, 4> componentGradientRanges{};
 };
+
+// The proxies of an input as the property uses them, in place of
+// scene.proxies (as vtkVolumeInputHelper prepares VTK's textures): the
+// input's component 0 as "scalars"; with `dependent` 2 or 4 (dependent
+// components) the opacity and colour components, with `independent` 2 to 4
+// each component and, while there is room, the gradient magnitude of each
+// one with gradient opacity; the gradient magnitude of the shaded or
+// opacity component when `needGradient`; and the mask (a label map when
+// `labels`, else binary) put on the input's grid by nearest neighbour.
+// Returns where each went. `warn` says what was left out. Throws
+// InputError when the combination needs more than kMaxProxies.
+ProxyLayout BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, vtkImageData* mask,
+  int dependent, int independent, bool needGradient, bool labels, Scene& scene,
+  const std::function<void(const std::string&)>& warn);
 
 // Replaces the scene's TFs, materials and selectors with those of the
 // property's component `component`: one material from its functions (the

@@ -55,7 +55,6 @@
 #include "vtkVolumeMapper.h"
 
 #include <memory> // for std::unique_ptr
-#include <vector> // for std::vector
 
 class vtkDataArray;
 class vtkIdList;
@@ -66,9 +65,6 @@ class vtkTexture;
 namespace mmrtm
 {
 class Film;
-struct ClipPlane;
-struct ProjectionSettings;
-struct SceneView;
 }
 
 class MMRTMRENDERING_EXPORT vtkMultiMaterialVolumeMapper : public vtkVolumeMapper

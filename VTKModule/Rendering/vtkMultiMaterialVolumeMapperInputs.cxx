@@ -16,9 +16,6 @@
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
 
-#include "derived_proxies.h"
-#include "label_alignment.h"
-#include "mmrtmImageDataConversion.h"
 #include "mmrtmVolumePropertyFunctions.h"
 #include "mmrtm/planted_defect.h"
 
@@ -67,7 +64,8 @@ bool vtkMultiMaterialVolumeMapper::Internals::ValidateInputs(vtkRenderer* ren, v
   Internals& in = *this;
   if (!Self->GetInput() || !vol->GetProperty())
   {
-    vtkErrorWithObjectMacro(Self, "Render: " << (Self->GetInput() ? "the vtkVolume has no volume property" : "no input"));
+    vtkErrorWithObjectMacro(
+      Self, "Render: " << (Self->GetInput() ? "the vtkVolume has no volume property" : "no input"));
     return false;
   }
   ren->GetTiledSizeAndOrigin(&viewport[0], &viewport[1], &viewport[2], &viewport[3]);
@@ -100,7 +98,8 @@ vtkMultiMaterialVolumeMapper::Internals::InputState vtkMultiMaterialVolumeMapper
   const bool isosurface = Self->BlendMode == vtkVolumeMapper::ISOSURFACE_BLEND && !in.MultiMaterial;
   const bool isosurfaceComponents = isosurface && (now.Proxies.Dependent || now.Proxies.Independent);
   if (in.Warn("isosurface with components", isosurfaceComponents))
-    vtkWarningWithObjectMacro(Self, "isosurface blending of " << components << " components is not supported; rendering as composite");
+    vtkWarningWithObjectMacro(Self,
+      "isosurface blending of " << components << " components is not supported; rendering as composite");
   now.Materials.Options.isosurface = isosurface && !isosurfaceComponents;
   if (now.Materials.Options.isosurface)
   {
@@ -172,7 +171,8 @@ void vtkMultiMaterialVolumeMapper::Internals::ReadTracedImage(InputState& now)
   now.Proxies.Scalars = c.Traced.Image ? c.Traced.Scalars : scalars;
   const bool resampled = vtkRectilinearGrid::SafeDownCast(input) != nullptr;
   if (in.Warn("rectilinear grid", resampled))
-    vtkWarningWithObjectMacro(Self, << c.Traced.Conversion << " (VTK's GPU mapper samples the grid on its own coordinates)");
+    vtkWarningWithObjectMacro(
+      Self, << c.Traced.Conversion << " (VTK's GPU mapper samples the grid on its own coordinates)");
 }
 
 vtkMultiMaterialVolumeMapper::Internals::Changes vtkMultiMaterialVolumeMapper::Internals::ChangesSince(
@@ -198,7 +198,10 @@ void vtkMultiMaterialVolumeMapper::Internals::UpdateProxies(const InputState& no
   in.HasScene = false; // until the rebuild succeeds
   const bool labels = now.Proxies.Mask && now.Proxies.MaskType == LABELMAP;
   const InputState::ProxyInputs& p = now.Proxies;
-  this->BuildProxies(now.Materials.Property, p.Data, p.Scalars, p.Dependent, p.Independent, p.NeedGradient, labels);
+  in.ImageIndexToWorld.clear();
+  in.Layout = mmrtm::BuildProxies(now.Materials.Property, p.Data, p.Scalars, p.Independent ? nullptr : in.Mask.Get(),
+    p.Dependent, p.Independent, p.NeedGradient, labels, in.Scene,
+    [&](const std::string& warning) { vtkWarningWithObjectMacro(Self, << warning); });
   int64_t nans = 0;
   for (const mmrtm::HostVolume& v : in.Scene.proxies)
     nans += v.nanVoxelsReplaced;
@@ -216,90 +219,6 @@ void vtkMultiMaterialVolumeMapper::Internals::UpdateProxies(const InputState& no
   in.Built.Materials.MultiMaterialTime = now.Materials.MultiMaterialTime; // parsed over them
   in.Built.Materials.LabelMaterialsTime = now.Materials.LabelMaterialsTime;
   ++in.SceneBuilds;
-}
-
-// The proxies of the input (its components as the property uses them), the
-// gradient magnitude when some function reads it, and the mask.
-void vtkMultiMaterialVolumeMapper::Internals::BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars,
-  int dependent, int independent, bool needGradient, bool labels)
-{
-  Internals& in = *this;
-  vtkImageData* mask = independent ? nullptr : in.Mask.Get();
-  mmrtm::Scene& scene = in.Scene;
-  scene.proxies.clear();
-  in.ImageIndexToWorld.clear();
-  in.Layout = mmrtm::ProxyLayout();
-  auto component = [&](int c, const char* name)
-  {
-    scene.proxies.push_back(mmrtm::ImageDataToHostVolume(input, scalars, c, name, mmrtm::Interpolation::Trilinear));
-    return static_cast<int>(scene.proxies.size()) - 1;
-  };
-  component(0, dependent == 4 ? "red" : "scalars");
-  in.Layout.scalarRange = scene.proxies[0].ValueRange();
-  scene.gradientProxy = 0;
-  if (independent)
-  {
-    in.Layout.independent = independent;
-    in.Layout.componentRanges[0] = in.Layout.scalarRange;
-    for (int c = 1; c < independent; ++c)
-      in.Layout.componentRanges[c] = scene.proxies[component(c, "component")].ValueRange();
-    // Gradient magnitudes of the components with gradient opacity, while
-    // there is room among the proxies.
-    for (int c = 0; c < independent; ++c)
-    {
-      if (!mmrtm::UsesGradientOpacity(property, c))
-        continue;
-      if (scene.proxies.size() >= static_cast<size_t>(mmrtm::kMaxProxies))
-      {
-        vtkWarningWithObjectMacro(Self, "no room for the gradient of component " << c << ": its gradient opacity is not used");
-        continue;
-      }
-      in.Layout.componentGradient[c] = static_cast<int>(scene.proxies.size());
-      scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[c], "gradient"));
-      in.Layout.componentGradientRanges[c] = scene.proxies.back().ValueRange();
-    }
-  }
-  if (dependent == 2)
-  {
-    in.Layout.opacity = component(1, "opacity");
-  }
-  else if (dependent == 4)
-  {
-    in.Layout.rgb[0] = 0;
-    in.Layout.rgb[1] = component(1, "green");
-    in.Layout.rgb[2] = component(2, "blue");
-    in.Layout.opacity = component(3, "opacity");
-    float top = 0.f;
-    for (int c = 0; c < 3; ++c)
-      top = std::max(top, scene.proxies[c].ValueRange()[1]);
-    in.Layout.colorScale = scalars->GetDataType() == VTK_UNSIGNED_CHAR ? 255.f : std::max(top, 1e-6f);
-  }
-  if (in.Layout.opacity >= 0)
-  {
-    in.Layout.opacityRange = scene.proxies[in.Layout.opacity].ValueRange();
-    scene.gradientProxy = in.Layout.opacity; // VTK shades dependent data by the opacity component
-  }
-  if (needGradient)
-  {
-    const int source = scene.gradientProxy;
-    in.Layout.gradient = static_cast<int>(scene.proxies.size());
-    scene.proxies.push_back(mmrtm::GradientMagnitudeProxy(scene.proxies[source], "gradient"));
-    in.Layout.gradientRange = scene.proxies.back().ValueRange();
-  }
-  if (mask)
-  {
-    // Labels are never interpolated; a mask on another grid is put on
-    // the input's by nearest neighbour in world space.
-    mmrtm::HostVolume m =
-      mmrtm::ImageDataToHostVolume(mask, nullptr, 0, labels ? "label map" : "mask", mmrtm::Interpolation::Nearest);
-    m = mmrtm::AlignLabelsToVolume(std::move(m), scene.proxies[0]);
-    (labels ? in.Layout.labels : in.Layout.binaryMask) = static_cast<int>(scene.proxies.size());
-    scene.proxies.push_back(std::move(m));
-  }
-  if (scene.proxies.size() > mmrtm::kMaxProxies)
-    throw mmrtm::InputError("this combination of components, gradient opacity and mask needs " +
-      std::to_string(scene.proxies.size()) + " proxy volumes; at most " + std::to_string(mmrtm::kMaxProxies) +
-      " are supported");
 }
 
 void vtkMultiMaterialVolumeMapper::Internals::ParseMultiMaterialScene()

@@ -73,7 +73,8 @@ struct vtkMultiMaterialVolumeMapper::Internals
       bool operator==(const ProxyInputs& o) const
       {
         return std::tie(this->Data, this->DataTime, this->Scalars, this->Mask, this->MaskTime, this->MaskType,
-                 this->MultiMaterial, this->Dependent, this->Independent, this->ComponentGradients, this->NeedGradient) ==
+                 this->MultiMaterial, this->Dependent, this->Independent, this->ComponentGradients,
+                 this->NeedGradient) ==
           std::tie(o.Data, o.DataTime, o.Scalars, o.Mask, o.MaskTime, o.MaskType, o.MultiMaterial, o.Dependent,
             o.Independent, o.ComponentGradients, o.NeedGradient);
       }
@@ -275,38 +276,46 @@ struct vtkMultiMaterialVolumeMapper::Internals
   };
   std::vector<std::unique_ptr<PeelFrame>> PeelFrames;
 
-  // The phases of a render, in the order RenderFrame runs them.
+  // A frame (vtkMultiMaterialVolumeMapper.cxx): the phases below, as far
+  // as the inputs changed, then drawing.
+  void RenderFrame(vtkRenderer* ren, vtkVolume* vol);
+  bool TracesInThisFrame(vtkRenderer* ren);
+
+  // The inputs and the scene made from them (...Inputs.cxx).
   bool ValidateInputs(vtkRenderer* ren, vtkVolume* vol, int viewport[4]);
   InputState ReadInputs(vtkRenderer* ren, vtkVolume* vol, const int viewport[4]);
   void ReadTracedImage(InputState& now); // the input as the tracer's image (part of ReadInputs)
   Changes ChangesSince(const InputState& built, const InputState& now);
   void UpdateProxies(const InputState& now);
-  void BuildProxies(vtkVolumeProperty* property, vtkImageData* input, vtkDataArray* scalars, int dependent,
-    int independent, bool needGradient, bool labels);
   void ParseMultiMaterialScene();
   void ReparseMultiMaterialScene();
   void UpdateDescription(const InputState& now);
   void UpdateMaterials(const InputState& now);
-  void ReadView(vtkRenderer* ren, vtkVolume* vol, const int viewport[4], InputState::ViewInputs& view);
-  static bool SameViewInputs(const InputState::ViewInputs& a, const InputState::ViewInputs& b);
-  void UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now);
-  std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
-  mmrtm::ProjectionSettings Projection(vtkVolumeProperty* property);
-  void UpdateEnvironment();
-  void TakeFilm(const InputState& now);
   void UpdateRenderer();
   mmrtm::SceneView BuildScene(); // the scene's Build, its summary build reported as VTK progress
-  void RenderFrame(vtkRenderer* ren, vtkVolume* vol);
-  bool TracesInThisFrame(vtkRenderer* ren);
+
+  // The view and the film it restarts (...View.cxx).
+  void ReadView(vtkRenderer* ren, vtkVolume* vol, const int viewport[4], InputState::ViewInputs& view);
+  static bool SameViewInputs(const InputState::ViewInputs& a, const InputState::ViewInputs& b);
+  std::vector<mmrtm::ClipPlane> ClipPlanes(vtkVolume* vol);
+  void UpdateView(vtkRenderer* ren, vtkVolume* vol, InputState& now);
+  mmrtm::ProjectionSettings Projection(vtkVolumeProperty* property);
+  void TakeFilm(const InputState& now);
   double RenderPreview(vtkRenderer* ren, int width, int height); // the tracing's seconds
   void AdaptPreview(double seconds, double tracedSeconds, double budgetSeconds);
+
+  // The environment texture as the tracer's map (...Environment.cxx).
+  void UpdateEnvironment();
+
+  // Adding samples, on this thread or the refinement thread, and the
+  // denoised display (...Refinement.cxx).
   const mmrtm::Film* Refine(bool restart);
   void FinishPass(bool cancel);
+  bool InputWillExecute();
+  const mmrtm::Film* ImageFilm();
   bool FilmConverged();    // the accumulation has reached MaximumSamples or NoiseTarget
   bool DenoisingApplies(); // a denoising mode, and noise to take out (not a projection)
   bool DenoiserReady();    // loads it at the first call
-  bool InputWillExecute();
-  const mmrtm::Film* ImageFilm();
 };
 
 #endif
