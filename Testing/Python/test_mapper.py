@@ -13,7 +13,7 @@ import sys
 import tempfile
 import unittest
 
-from vtkmodules.vtkCommonCore import vtkCommand, vtkFloatArray
+from vtkmodules.vtkCommonCore import vtkCommand, vtkFloatArray, vtkIdList
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction, vtkPlane, vtkPlaneCollection
 from vtkmodules.vtkImagingCore import vtkImageAppendComponents, vtkImageShiftScale, vtkImageThreshold
 from vtkmodules.vtkIOImage import vtkNrrdReader, vtkPNGReader
@@ -23,7 +23,8 @@ from vtkmodules.vtkRenderingCore import (vtkActor, vtkTexture, vtkPolyDataMapper
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401  (the image display helper)
 
-from vtkmodules.util.vtkConstants import VTK_STRING
+from vtkmodules.util.vtkConstants import (VTK_FLOAT, VTK_INT, VTK_SHORT, VTK_STRING, VTK_UNSIGNED_CHAR,
+                                           VTK_UNSIGNED_SHORT)
 
 from mmrtm import vtkMultiMaterialProperty, vtkMultiMaterialVolumeMapper, vtkMultiMaterialVolumeReader
 
@@ -781,6 +782,35 @@ class MapperTest(unittest.TestCase):
             sum(functions) / 6, sum(look) / 6, z(functions, look), sum(fainter) / 6, z(functions, fainter)))
         self.assertLess(abs(z(functions, look)), 4.5)
         self.assertGreater(abs(z(functions, fainter)), 4.5, "the check sees the lower opacity")
+
+    def test_the_labels_present_in_a_label_map(self):
+        """GetLabelsPresent, the front ends' one label scan (the viewer's
+        label list, ParaView's label-map array): the distinct non-zero
+        values, ascending, for each voxel type; an image of fractional
+        values, of two components or without scalars is refused with a
+        warning and no labels. Catches label 0 counted, a label missed or
+        repeated, and a fractional value truncated into a label."""
+        def label_map(vtk_type, values, components=1):
+            image = vtkImageData()
+            image.SetDimensions(len(values) // components, 1, 1)
+            image.AllocateScalars(vtk_type, components)
+            scalars = image.GetPointData().GetScalars()
+            for i, v in enumerate(values):
+                scalars.SetValue(i, v)
+            return image
+
+        def present(image):
+            ids = vtkIdList()
+            ids.InsertNextId(99)  # emptied first
+            found = vtkMultiMaterialVolumeMapper.GetLabelsPresent(image, ids)
+            return found, [ids.GetId(i) for i in range(ids.GetNumberOfIds())]
+
+        for vtk_type in (VTK_UNSIGNED_CHAR, VTK_SHORT, VTK_UNSIGNED_SHORT, VTK_INT, VTK_FLOAT):
+            self.assertEqual(present(label_map(vtk_type, [0, 7, 3, 7, 0, 12, 3])), (True, [3, 7, 12]), vtk_type)
+        # Refused, each with a warning on VTK's output window.
+        self.assertEqual(present(label_map(VTK_FLOAT, [0, 1.5, 2])), (False, []))
+        self.assertEqual(present(label_map(VTK_UNSIGNED_CHAR, [0, 1, 2, 3], components=2)), (False, []))
+        self.assertEqual(present(vtkImageData()), (False, []))
 
     def test_each_warning_once_for_its_own_cause(self):
         """Each of the mapper's warnings is said once when its cause appears,
