@@ -586,6 +586,18 @@ std::vector<Case> Cases()
     false, Work::Display });
   c.push_back({ "modified-only", Input::Head, HeadFunctions, [](Objects& o) { o.mapper->Modified(); }, false,
     Work::Display });
+  // The image sample distances decide the still film's size: a distance
+  // the still render does not use (AutoAdjust on: ImageSampleDistance; the
+  // previews' largest) keeps the samples, one that sizes the film restarts.
+  c.push_back({ "image-sample-distance-unused", Input::Head, HeadFunctions,
+    [](Objects& o)
+    {
+      o.mapper->SetImageSampleDistance(2.0f);
+      o.mapper->SetMaximumImageSampleDistance(4.0f);
+    },
+    false, Work::Display });
+  c.push_back({ "minimum-image-sample-distance", Input::Head, HeadFunctions,
+    [](Objects& o) { o.mapper->SetMinimumImageSampleDistance(2.0f); }, true, Work::Restart });
   c.push_back({ "cropping", Input::Head, HeadFunctions,
     [](Objects& o)
     {

@@ -51,7 +51,8 @@ bool SameValues(const std::vector<double>& a, const std::vector<double>& b)
 // the modification times of the objects the mapper holds (`held`: each a
 // tick of VTK's global clock, so another object is another time). Not
 // among them: the drawing's settings and the refinement's, which keep the
-// samples.
+// samples, and the image sample distances, which decide the film's size
+// (compared with the view) and the previews'.
 std::vector<double> TracingInputs(vtkMultiMaterialVolumeMapper* m, std::initializer_list<vtkMTimeType> held)
 {
   std::vector<double> v = { static_cast<double>(m->GetSeed()), static_cast<double>(m->GetBackend()),
@@ -60,7 +61,7 @@ std::vector<double> TracingInputs(vtkMultiMaterialVolumeMapper* m, std::initiali
     static_cast<double>(m->GetAccelerator()), static_cast<double>(m->GetUnshadedScattering()),
     static_cast<double>(m->GetBlendMode()), static_cast<double>(m->GetAutoAdjustSampleDistances()),
     m->GetSampleDistance(), m->GetAverageIPScalarRange()[0], m->GetAverageIPScalarRange()[1],
-    m->GetImageSampleDistance(), m->GetMinimumImageSampleDistance(), static_cast<double>(m->GetMaskType()),
+    static_cast<double>(m->GetMaskType()),
     m->GetEnvironmentIntensity(), static_cast<double>(m->GetScalarMode()),
     static_cast<double>(m->GetArrayAccessMode()), static_cast<double>(m->GetArrayId()),
     static_cast<double>(m->GetCropping()), static_cast<double>(m->GetCroppingRegionFlags()) };

@@ -484,6 +484,8 @@ public:
    * that a frame takes the volume's AllocatedRenderTime (which VTK's
    * renderer sets from the window's DesiredUpdateRate, divided among the
    * props). Off: still renders and previews are at ImageSampleDistance.
+   * A change restarts the accumulation only when it changes the still
+   * film's size.
    */
   vtkSetClampMacro(ImageSampleDistance, float, 0.1f, 100.0f);
   vtkGetMacro(ImageSampleDistance, float);
@@ -564,7 +566,7 @@ public:
   /**
    * When what the mapper traces last changed, compared by value: its
    * settings that the traced image depends on (seed, bounces, sampler,
-   * accelerator, backend, blend mode, sample distances, cropping, clipping
+   * accelerator, backend, blend mode, SampleDistance, cropping, clipping
    * planes, environment intensity) and the times of what it holds (mask,
    * multi-material property, label materials, environment texture). A
    * setting that keeps the samples (exposure, tone mapping, denoising,
