@@ -265,12 +265,19 @@ void vtkMultiMaterialVolumeRepresentation::UpdateLabelMap()
   vtkNew<vtkImageData> mask;
   mask->CopyStructure(image);
   mask->GetPointData()->SetScalars(labels);
+  vtkNew<vtkIdList> found;
+  if (!vtkMultiMaterialVolumeMapper::GetLabelsPresent(mask, found))
+  {
+    vtkWarningMacro(
+      "the label map array \"" << this->LabelMapArray << "\" does not hold whole-number labels: no label map");
+    this->Mapper()->SetMaskInput(nullptr);
+    this->Mapper()->RemoveAllLabelMaterials();
+    return;
+  }
   this->Mapper()->SetMaskInput(mask);
   this->Mapper()->SetMaskTypeToLabelMap();
 
   // Up to 64 labels (0 is the background): more is not a label map.
-  vtkNew<vtkIdList> found;
-  vtkMultiMaterialVolumeMapper::GetLabelsPresent(mask, found);
   if (found->GetNumberOfIds() > 64)
   {
     vtkWarningMacro(

@@ -10,6 +10,7 @@
 #define vtkMultiMaterialVolumeMapperInternals_h
 
 #include <atomic>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -310,6 +311,7 @@ struct vtkMultiMaterialVolumeMapper::Internals
   // Adding samples, on this thread or the refinement thread, and the
   // denoised display (...Refinement.cxx).
   const mmrtm::Film* Refine(bool restart);
+  void StartPass(bool denoising, std::function<void(Pass&)> work); // in flight on a thread of its own
   void FinishPass(bool cancel);
   bool InputWillExecute();
   const mmrtm::Film* ImageFilm();

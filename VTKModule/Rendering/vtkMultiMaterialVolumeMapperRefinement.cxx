@@ -43,27 +43,13 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Internals::Refine(bool restart)
   {
     // A denoise of the image shown, before more samples: on the thread of
     // the passes, so that this render returns at once.
-    auto pass = std::make_unique<Internals::Pass>();
-    Internals::Pass* p = pass.get();
-    p->Denoising = true;
     auto snapshot = std::make_shared<mmrtm::FilmSnapshot>(mmrtm::SnapshotFilm(*in.Shown, in.FilmGeneration));
     const bool estimate = in.Display.WantsEstimate(in.FilmGeneration, in.Shown->Samples());
     mmrtm::Denoiser* denoiser = in.Denoiser.get();
     in.Display.Started();
-    p->Thread = std::thread(
-      [p, snapshot, estimate, denoiser]
-      {
-        try
-        {
-          p->Denoised = mmrtm::DenoiseSnapshot(*snapshot, estimate, true, mmrtm::OidnDenoise(*denoiser), &p->Cancel);
-        }
-        catch (const std::exception& e)
-        {
-          p->Error = e.what();
-        }
-        p->Done = true;
-      });
-    in.InFlight = std::move(pass);
+    this->StartPass(true,
+      [snapshot, estimate, denoiser](Pass& p)
+      { p.Denoised = mmrtm::DenoiseSnapshot(*snapshot, estimate, true, mmrtm::OidnDenoise(*denoiser), &p.Cancel); });
     return in.Shown.get();
   }
   if (samples > 0)
@@ -72,25 +58,11 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Internals::Refine(bool restart)
   {
     // The next pass on a thread of its own, under in.Built; this render
     // draws the last finished image.
-    auto pass = std::make_unique<Internals::Pass>();
-    Internals::Pass* p = pass.get();
     mmrtm::Renderer* renderer = in.Renderer.get();
     mmrtm::Film* film = in.Film.get();
     const mmrtm::Scene* scene = &in.Scene;
-    p->Thread = std::thread(
-      [p, renderer, film, scene, sceneView, samples]
-      {
-        try
-        {
-          p->Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p->Cancel);
-        }
-        catch (const std::exception& e)
-        {
-          p->Error = e.what();
-        }
-        p->Done = true;
-      });
-    in.InFlight = std::move(pass);
+    this->StartPass(false, [renderer, film, scene, sceneView, samples](Pass& p)
+      { p.Completed = renderer->Render(*scene, sceneView, *film, samples, nullptr, nullptr, &p.Cancel); });
     return in.Shown.get();
   }
   if (samples > 0)
@@ -115,6 +87,30 @@ const mmrtm::Film* vtkMultiMaterialVolumeMapper::Internals::Refine(bool restart)
     in.Display.Finished(std::move(denoised));
   }
   return in.Film.get();
+}
+
+// `work` on a thread of its own, as the pass in flight (a denoise of Shown
+// when `denoising`, else samples); what it throws is the pass's error, said
+// when the pass is finished (FinishPass).
+void vtkMultiMaterialVolumeMapper::Internals::StartPass(bool denoising, std::function<void(Pass&)> work)
+{
+  auto pass = std::make_unique<Pass>();
+  Pass* p = pass.get();
+  p->Denoising = denoising;
+  p->Thread = std::thread(
+    [p, work = std::move(work)]
+    {
+      try
+      {
+        work(*p);
+      }
+      catch (const std::exception& e)
+      {
+        p->Error = e.what();
+      }
+      p->Done = true;
+    });
+  this->InFlight = std::move(pass);
 }
 
 void vtkMultiMaterialVolumeMapper::Internals::FinishPass(bool cancel)
